@@ -1,0 +1,56 @@
+//! The error type of every fallible operation of the library.
+
+use crate::mesh::MeshError;
+use std::fmt;
+
+/// Why an operation failed. Whatever failed left the world as it was.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// A mesh file could not be read or is malformed (names the file and, where known, the line).
+    Mesh(MeshError),
+    /// An argument is out of its valid range (the message says which and why).
+    InvalidArgument(String),
+    /// An input holds NaN or ±Inf (the message says which).
+    NonFinite(String),
+    /// No body with this id exists in the world.
+    UnknownBody(u32),
+    /// No tool with this id exists in the world.
+    UnknownTool(u32),
+    /// A caller-provided buffer is too small: `needed` elements are required.
+    BufferTooSmall {
+        /// Number of elements the buffer must hold.
+        needed: usize,
+    },
+    /// A saved state cannot be restored into this world (version, size or scene mismatch).
+    BadState(String),
+    /// An I/O error other than a mesh read (writing a VTU file, for instance).
+    Io(String),
+    /// A step produced NaN or Inf; the world was rolled back to its state before the step.
+    Diverged(String),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Mesh(e) => write!(f, "{e}"),
+            Error::InvalidArgument(m) => write!(f, "invalid argument: {m}"),
+            Error::NonFinite(m) => write!(f, "non-finite input: {m}"),
+            Error::UnknownBody(id) => write!(f, "unknown body id {id}"),
+            Error::UnknownTool(id) => write!(f, "unknown tool id {id}"),
+            Error::BufferTooSmall { needed } => {
+                write!(f, "buffer too small: {needed} elements needed")
+            }
+            Error::BadState(m) => write!(f, "cannot restore state: {m}"),
+            Error::Io(m) => write!(f, "I/O error: {m}"),
+            Error::Diverged(m) => write!(f, "step diverged and was rolled back: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<MeshError> for Error {
+    fn from(e: MeshError) -> Self {
+        Error::Mesh(e)
+    }
+}

@@ -1,0 +1,2 @@
+//! The main job: the embedded default scene (see README).
+fn main() {}

@@ -1,0 +1,23 @@
+//! Scalar and linear-algebra aliases, the 3×3 rotation extraction used by the corotated stress,
+//! and conversions at the parry boundary.
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+/// The scalar type of the solver: every length (m), mass (kg), time (s) and force (N) is an `f64`.
+pub type Real = f64;
+/// A 3-vector of [`Real`] (a position in m, a velocity in m/s, a force in N, ...).
+pub type Vec3 = Vector3<Real>;
+/// A 3×3 matrix of [`Real`] (deformation gradient, stress in Pa, rotation).
+pub type Mat3 = Matrix3<Real>;
+/// A unit quaternion (orientation of a tool).
+pub type Quat = UnitQuaternion<Real>;
+
+/// True when every component of `v` is finite (neither NaN nor ±Inf).
+pub fn is_finite_vec(v: &Vec3) -> bool {
+    v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
+}
+
+/// Signed volume (m³) of the tetrahedron `a, b, c, d`: positive when `((b-a)×(c-a))·(d-a) > 0`.
+pub fn tet_volume(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> Real {
+    (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
+}

@@ -1,0 +1,134 @@
+//! Tetrahedral meshes: the in-memory [`TetMesh`], one reader per file format, OBJ surfaces for
+//! tools, the VTU writer, and the embedded default organ.
+//!
+//! Readers return node positions multiplied by the caller's `scale` (mesh units → metres).
+//! Every mesh goes through [`TetMesh::from_raw`], which re-orients inverted tetrahedra, removes
+//! degenerate ones and unreferenced nodes, and reports what it did in a [`MeshReport`].
+
+use crate::math::{Real, Vec3};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A tetrahedral mesh: node positions (m) and tetrahedra as 4 node indices each, every
+/// tetrahedron positively oriented (`((b-a)×(c-a))·(d-a) > 0`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TetMesh {
+    /// Node positions (m), one per node.
+    pub nodes: Vec<Vec3>,
+    /// Tetrahedra, four indices into `nodes` each, positively oriented.
+    pub tets: Vec<[u32; 4]>,
+}
+
+/// What cleaning a raw mesh changed.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MeshReport {
+    /// Tetrahedra whose orientation was negative and that were re-oriented (two nodes swapped).
+    pub reoriented_tets: usize,
+    /// Tetrahedra of (near) zero volume that were removed.
+    pub degenerate_tets_removed: usize,
+    /// Nodes that no tetrahedron references and that were removed (indices renumbered).
+    pub unreferenced_nodes_removed: usize,
+    /// Elements of other types (points, lines, triangles, ...) skipped by the reader.
+    pub skipped_elements: usize,
+}
+
+/// A mesh that could not be read: the file, the line (1-based) where known, and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshError {
+    /// The file that failed (empty for meshes built from arrays).
+    pub path: PathBuf,
+    /// The 1-based line where the problem was found, when it is tied to one.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+impl MeshError {
+    /// An error in `path` at 1-based `line`.
+    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> Self {
+        MeshError {
+            path: path.to_path_buf(),
+            line: Some(line),
+            message: message.into(),
+        }
+    }
+    /// An error in `path` not tied to a line.
+    pub fn file(path: &Path, message: impl Into<String>) -> Self {
+        MeshError {
+            path: path.to_path_buf(),
+            line: None,
+            message: message.into(),
+        }
+    }
+}
+
+/// A triangulated surface (an OBJ tool shape): vertices (m) and triangles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceMesh {
+    /// Vertex positions (m).
+    pub vertices: Vec<Vec3>,
+    /// Triangles, three vertex indices each.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Load a tetrahedral mesh, choosing the reader from the file name: `.msh` (Gmsh v1, 2.2 or
+/// 4.1 ASCII), `.node` / `.ele` (TetGen, 0- or 1-based), `.vtk` (legacy VTK ASCII
+/// `UNSTRUCTURED_GRID`). Node positions are multiplied by `scale` (mesh units → m).
+pub fn load(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport), MeshError> {
+    let _ = (path, scale);
+    todo!()
+}
+
+/// Read a Wavefront OBJ surface (`v` and `f` records; polygons fan-triangulated), positions
+/// multiplied by `scale`.
+pub fn read_obj(path: &Path, scale: Real) -> Result<SurfaceMesh, MeshError> {
+    let _ = (path, scale);
+    todo!()
+}
+
+/// The embedded default organ: a liver-like lobed solid about 0.2 m across, tetrahedralised
+/// by the project's own code. Needs no file.
+pub fn default_organ() -> TetMesh {
+    todo!()
+}
+
+impl TetMesh {
+    /// Validate and clean raw arrays: indices in range, inverted tetrahedra re-oriented,
+    /// degenerate ones and unreferenced nodes removed. `path` names the source in errors.
+    pub fn from_raw(
+        nodes: Vec<Vec3>,
+        tets: Vec<[u32; 4]>,
+        path: &Path,
+    ) -> Result<(TetMesh, MeshReport), MeshError> {
+        let _ = (nodes, tets, path);
+        todo!()
+    }
+    /// Boundary triangles (faces belonging to one tetrahedron only), outward oriented, in a
+    /// deterministic order.
+    pub fn boundary_triangles(&self) -> Vec<[u32; 3]> {
+        todo!()
+    }
+    /// Sum of the tetrahedron volumes (m³).
+    pub fn volume(&self) -> Real {
+        todo!()
+    }
+    /// Axis-aligned bounding box `(min, max)` of the nodes (m).
+    pub fn bounding_box(&self) -> (Vec3, Vec3) {
+        todo!()
+    }
+    /// Mean length of the tetrahedron edges (m).
+    pub fn mean_edge_length(&self) -> Real {
+        todo!()
+    }
+}

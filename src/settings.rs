@@ -1,0 +1,112 @@
+//! The world's settings: one plain struct, every field in SI units, with a [`Default`] suited to
+//! an organ of ~0.2 m stepped at 1 kHz.
+
+use crate::math::{Real, Vec3};
+
+/// How tool–tissue contact is detected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMode {
+    /// Exact distance from each particle to the tool's shape (parry point projection, with
+    /// inside detection). The default: no gaps between samples, a smooth force.
+    ExactShape,
+    /// The paper's mode: the tool surface sampled into points, each a sphere of radius equal to
+    /// the sample spacing; particles are pushed out of those spheres.
+    SampledPoints,
+}
+
+/// Parameters of the time integration and of the constraint projection.
+///
+/// Modelled after rapier's `IntegrationParameters`: plain data, `Default`, units on every field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Time step of one call to [`World::step`](crate::World::step) (s).
+    pub dt: Real,
+    /// Gravity acceleration (m/s²).
+    pub gravity: Vec3,
+    /// Smallest number of substeps per step (≥ 1). The world adds substeps when the explicit
+    /// elastic step would be unstable (see [`Settings::stability_margin`]).
+    pub min_substeps: u32,
+    /// Largest number of substeps per step; a step that needs more is reported
+    /// (`StepReport::substeps_clamped`) and runs with this many.
+    pub max_substeps: u32,
+    /// Fraction (0, 1] of the explicit stability limit `2/ω_max` that a substep may use.
+    pub stability_margin: Real,
+    /// Mass-proportional (ambient) damping rate α (1/s): each substep scales particle velocities
+    /// by `1/(1 + α·dt)`. Models the viscous surroundings of an organ; damps rigid motion too.
+    pub damping_mass: Real,
+    /// Stiffness-proportional damping time β (s): a dashpot on each neighbour pair with
+    /// coefficient β·k_ij (k_ij the pair's elastic stiffness, N/m), acting along the pair.
+    /// Central and zero under rigid motion, so momentum is conserved.
+    pub damping_stiffness: Real,
+    /// Hourglass-control stiffness (dimensionless, multiplies Young's modulus): penalises the
+    /// part of each pair's deformation that the particle's deformation gradient does not explain
+    /// (Ganzenmüller 2015), which suppresses the zero-energy modes of MLS particle methods.
+    pub hourglass_stiffness: Real,
+    /// Enable the XPBD per-tetrahedron volume constraints (eq. 13 of the paper).
+    pub volume_constraints: bool,
+    /// Volume compliance (1/Pa): the inverse of the bulk modulus the constraints add;
+    /// 0 makes every tetrahedron's volume a hard constraint.
+    pub volume_compliance: Real,
+    /// Gauss–Seidel iterations over all constraints per substep.
+    pub iterations: u32,
+    /// How tool–tissue contact is detected.
+    pub contact_mode: ContactMode,
+    /// Enable contact between particles of the same body (off by default).
+    pub self_contact: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            dt: 1.0e-3,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            min_substeps: 1,
+            max_substeps: 64,
+            stability_margin: 0.9,
+            damping_mass: 2.0,
+            damping_stiffness: 0.0,
+            hourglass_stiffness: 0.05,
+            volume_constraints: true,
+            volume_compliance: 0.0,
+            iterations: 1,
+            contact_mode: ContactMode::ExactShape,
+            self_contact: false,
+        }
+    }
+}
+
+impl Settings {
+    /// Check every field is finite and in range; the message names the first one that is not.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        use crate::Error;
+        let bad = |m: &str| Err(Error::InvalidArgument(m.to_string()));
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return bad("dt must be finite and > 0 s");
+        }
+        if !crate::math::is_finite_vec(&self.gravity) {
+            return Err(Error::NonFinite("gravity".into()));
+        }
+        if self.min_substeps == 0 || self.max_substeps < self.min_substeps {
+            return bad("substeps: need 1 <= min_substeps <= max_substeps");
+        }
+        if !(self.stability_margin > 0.0 && self.stability_margin <= 1.0) {
+            return bad("stability_margin must be in (0, 1]");
+        }
+        for (name, v) in [
+            ("damping_mass", self.damping_mass),
+            ("damping_stiffness", self.damping_stiffness),
+            ("hourglass_stiffness", self.hourglass_stiffness),
+            ("volume_compliance", self.volume_compliance),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} must be finite and >= 0"
+                )));
+            }
+        }
+        if self.iterations == 0 {
+            return bad("iterations must be >= 1");
+        }
+        Ok(())
+    }
+}
