@@ -30,6 +30,8 @@ pub struct MeshReport {
     pub unreferenced_nodes_removed: usize,
     /// Elements of other types (points, lines, triangles, ...) skipped by the reader.
     pub skipped_elements: usize,
+    /// For each node kept, its 0-based position in the file's node list (file order).
+    pub original_node_index: Vec<u32>,
 }
 
 /// A mesh that could not be read: the file, the line (1-based) where known, and what is wrong.
@@ -94,6 +96,25 @@ pub fn load(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport), MeshError
 /// multiplied by `scale`.
 pub fn read_obj(path: &Path, scale: Real) -> Result<SurfaceMesh, MeshError> {
     let _ = (path, scale);
+    todo!()
+}
+
+/// Write `mesh` as legacy VTK ASCII `UNSTRUCTURED_GRID` (cell type 10), readable by [`load`].
+pub fn write_vtk(path: &Path, mesh: &TetMesh) -> std::io::Result<()> {
+    let _ = (path, mesh);
+    todo!()
+}
+
+/// Write a body's state for ParaView as VTU (XML `UnstructuredGrid`, ASCII): points (m),
+/// tetrahedra, and per-point data arrays (scalars and 3-vectors, named).
+pub fn write_vtu(
+    path: &Path,
+    positions: &[Vec3],
+    tets: &[[u32; 4]],
+    point_scalars: &[(&str, &[Real])],
+    point_vectors: &[(&str, &[Vec3])],
+) -> std::io::Result<()> {
+    let _ = (path, positions, tets, point_scalars, point_vectors);
     todo!()
 }
 
