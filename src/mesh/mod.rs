@@ -5,9 +5,18 @@
 //! Every mesh goes through [`TetMesh::from_raw`], which re-orients inverted tetrahedra, removes
 //! degenerate ones and unreferenced nodes, and reports what it did in a [`MeshReport`].
 
-use crate::math::{Real, Vec3};
+use crate::math::{tet_volume, Real, Vec3};
 use std::fmt;
 use std::path::{Path, PathBuf};
+
+mod boundary;
+mod clean;
+mod lattice;
+mod parse;
+mod tetgen;
+
+pub use clean::DEGENERATE_RELATIVE_VOLUME;
+pub use lattice::lattice_box;
 
 /// A tetrahedral mesh: node positions (m) and tetrahedra as 4 node indices each, every
 /// tetrahedron positively oriented (`((b-a)×(c-a))·(d-a) > 0`).
@@ -87,9 +96,30 @@ pub struct SurfaceMesh {
 /// Load a tetrahedral mesh, choosing the reader from the file name: `.msh` (Gmsh v1, 2.2 or
 /// 4.1 ASCII), `.node` / `.ele` (TetGen, 0- or 1-based), `.vtk` (legacy VTK ASCII
 /// `UNSTRUCTURED_GRID`). Node positions are multiplied by `scale` (mesh units → m).
+///
+/// A path without one of these extensions is read as a TetGen base name when `<path>.node`
+/// exists. `scale` must be finite and > 0.
 pub fn load(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport), MeshError> {
-    let _ = (path, scale);
-    todo!()
+    parse::check_scale(path, scale)?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("node") | Some("ele") => tetgen::read_tetgen(path, scale),
+        Some("msh") => todo!(),
+        Some("vtk") => todo!(),
+        _ if tetgen::tetgen_paths(path).0.is_file() => tetgen::read_tetgen(path, scale),
+        Some(e) => Err(MeshError::file(
+            path,
+            format!("unknown mesh file extension `.{e}` (expected .msh, .node, .ele or .vtk)"),
+        )),
+        None => Err(MeshError::file(
+            path,
+            "no file extension and no TetGen `.node` file of that base name \
+             (expected .msh, .node, .ele or .vtk)",
+        )),
+    }
 }
 
 /// Read a Wavefront OBJ surface (`v` and `f` records; polygons fan-triangulated), positions
@@ -132,24 +162,64 @@ impl TetMesh {
         tets: Vec<[u32; 4]>,
         path: &Path,
     ) -> Result<(TetMesh, MeshReport), MeshError> {
-        let _ = (nodes, tets, path);
-        todo!()
+        clean::clean(nodes, tets, path)
     }
     /// Boundary triangles (faces belonging to one tetrahedron only), outward oriented, in a
     /// deterministic order.
     pub fn boundary_triangles(&self) -> Vec<[u32; 3]> {
-        todo!()
+        boundary::boundary_triangles(self)
     }
     /// Sum of the tetrahedron volumes (m³).
     pub fn volume(&self) -> Real {
-        todo!()
+        let n = self.nodes.len();
+        self.tets
+            .iter()
+            .filter(|t| t.iter().all(|&i| (i as usize) < n))
+            .map(|t| {
+                let p = |k: usize| &self.nodes[t[k] as usize];
+                tet_volume(p(0), p(1), p(2), p(3))
+            })
+            .sum()
     }
     /// Axis-aligned bounding box `(min, max)` of the nodes (m).
+    ///
+    /// An empty mesh gives `(0, 0)`.
     pub fn bounding_box(&self) -> (Vec3, Vec3) {
-        todo!()
+        let Some(first) = self.nodes.first() else {
+            return (Vec3::zeros(), Vec3::zeros());
+        };
+        self.nodes
+            .iter()
+            .fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
     }
     /// Mean length of the tetrahedron edges (m).
+    ///
+    /// Every edge shared by several tetrahedra counts once; an empty mesh gives 0.
     pub fn mean_edge_length(&self) -> Real {
-        todo!()
+        let n = self.nodes.len();
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(self.tets.len() * 6);
+        for t in self
+            .tets
+            .iter()
+            .filter(|t| t.iter().all(|&i| (i as usize) < n))
+        {
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    if t[a] != t[b] {
+                        edges.push((t[a].min(t[b]), t[a].max(t[b])));
+                    }
+                }
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        if edges.is_empty() {
+            return 0.0;
+        }
+        let total: Real = edges
+            .iter()
+            .map(|&(a, b)| (self.nodes[a as usize] - self.nodes[b as usize]).norm())
+            .sum();
+        total / edges.len() as Real
     }
 }
