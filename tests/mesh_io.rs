@@ -163,3 +163,36 @@ fn unreferenced_inverted_and_degenerate_tets_are_cleaned() {
         TetMesh::from_raw(nodes, vec![[0, 1, 2, 9]], Path::new("arrays")).unwrap_err();
     assert!(e.to_string().contains("arrays"));
 }
+
+#[test]
+fn gmsh_v1_meshes_load_with_readme_counts() {
+    let (m, r) = mesh::load(&shared("liver.msh"), 1.0).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((m.nodes.len(), m.tets.len()), (181, 596));
+    assert_eq!(r.skipped_elements, 0);
+    let (m, r) = mesh::load(&shared("liver2.msh"), 1.0).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((m.nodes.len(), m.tets.len()), (507, 1493));
+    assert_eq!(r.skipped_elements, 860 + 71);
+    assert!(signed_volumes(&m).iter().all(|&v| v > 0.0));
+}
+
+#[test]
+fn liver_4k_is_the_same_mesh_in_three_formats() {
+    let (a, ra) = mesh::load(&shared("liver_4k.node"), 0.03).unwrap();
+    let (b, rb) = mesh::load(&shared("liver_4k.msh"), 0.03).unwrap_or_else(|e| panic!("{e}"));
+    let (c, rc) = mesh::load(&shared("liver_4k.vtk"), 0.03).unwrap_or_else(|e| panic!("{e}"));
+    for (name, m, r) in [("msh", &b, &rb), ("vtk", &c, &rc)] {
+        assert_eq!(m.tets, a.tets, "{name}: same connectivity");
+        assert_eq!(m.nodes.len(), a.nodes.len());
+        let max_diff = m
+            .nodes
+            .iter()
+            .zip(&a.nodes)
+            .map(|(p, q)| (p - q).norm())
+            .fold(0.0, f64::max);
+        assert!(
+            max_diff < 1e-6 * 0.03,
+            "{name}: positions differ by {max_diff} m"
+        );
+        assert_eq!(r.original_node_index, ra.original_node_index);
+    }
+}

@@ -11,9 +11,11 @@ use std::path::{Path, PathBuf};
 
 mod boundary;
 mod clean;
+mod gmsh;
 mod lattice;
 mod parse;
 mod tetgen;
+mod vtk;
 
 pub use clean::DEGENERATE_RELATIVE_VOLUME;
 pub use lattice::lattice_box;
@@ -107,8 +109,8 @@ pub fn load(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport), MeshError
         .map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("node") | Some("ele") => tetgen::read_tetgen(path, scale),
-        Some("msh") => todo!(),
-        Some("vtk") => todo!(),
+        Some("msh") => gmsh::read_gmsh(path, scale),
+        Some("vtk") => vtk::read_vtk(path, scale),
         _ if tetgen::tetgen_paths(path).0.is_file() => tetgen::read_tetgen(path, scale),
         Some(e) => Err(MeshError::file(
             path,
@@ -131,8 +133,7 @@ pub fn read_obj(path: &Path, scale: Real) -> Result<SurfaceMesh, MeshError> {
 
 /// Write `mesh` as legacy VTK ASCII `UNSTRUCTURED_GRID` (cell type 10), readable by [`load`].
 pub fn write_vtk(path: &Path, mesh: &TetMesh) -> std::io::Result<()> {
-    let _ = (path, mesh);
-    todo!()
+    vtk::write_vtk(path, mesh)
 }
 
 /// Write a body's state for ParaView as VTU (XML `UnstructuredGrid`, ASCII): points (m),

@@ -158,6 +158,7 @@ impl<'a> Fields<'a> {
 
 /// Whitespace-separated tokens of a text, each with its 1-based line number (for formats such
 /// as legacy VTK whose records may span or share lines).
+#[derive(Clone)]
 pub(crate) struct Tokens<'a> {
     path: &'a Path,
     text: &'a str,
@@ -203,21 +204,6 @@ impl<'a> Tokens<'a> {
             self.pos += 1;
         }
         Some((&self.text[start..self.pos], self.line))
-    }
-
-    /// The rest of the current line (trimmed), moving to the start of the next line.
-    pub(crate) fn rest_of_line(&mut self) -> &'a str {
-        let bytes = self.text.as_bytes();
-        let start = self.pos;
-        while self.pos < bytes.len() && bytes[self.pos] != b'\n' {
-            self.pos += 1;
-        }
-        let s = &self.text[start..self.pos];
-        if self.pos < bytes.len() {
-            self.pos += 1;
-            self.line += 1;
-        }
-        s.trim()
     }
 
     /// The next token, or an error saying `what` was expected at the end of file.
