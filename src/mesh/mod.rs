@@ -13,9 +13,12 @@ mod boundary;
 mod clean;
 mod gmsh;
 mod lattice;
+mod obj;
+mod organ;
 mod parse;
 mod tetgen;
 mod vtk;
+mod vtu;
 
 pub use clean::DEGENERATE_RELATIVE_VOLUME;
 pub use lattice::lattice_box;
@@ -127,8 +130,7 @@ pub fn load(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport), MeshError
 /// Read a Wavefront OBJ surface (`v` and `f` records; polygons fan-triangulated), positions
 /// multiplied by `scale`.
 pub fn read_obj(path: &Path, scale: Real) -> Result<SurfaceMesh, MeshError> {
-    let _ = (path, scale);
-    todo!()
+    obj::read_obj(path, scale)
 }
 
 /// Write `mesh` as legacy VTK ASCII `UNSTRUCTURED_GRID` (cell type 10), readable by [`load`].
@@ -145,14 +147,13 @@ pub fn write_vtu(
     point_scalars: &[(&str, &[Real])],
     point_vectors: &[(&str, &[Vec3])],
 ) -> std::io::Result<()> {
-    let _ = (path, positions, tets, point_scalars, point_vectors);
-    todo!()
+    vtu::write_vtu(path, positions, tets, point_scalars, point_vectors)
 }
 
 /// The embedded default organ: a liver-like lobed solid about 0.2 m across, tetrahedralised
 /// by the project's own code. Needs no file.
 pub fn default_organ() -> TetMesh {
-    todo!()
+    organ::build_default_organ()
 }
 
 impl TetMesh {

@@ -164,6 +164,8 @@ pub(crate) struct Tokens<'a> {
     text: &'a str,
     pos: usize,
     line: usize,
+    /// Line of the last token returned (where "unexpected end of file" is reported).
+    last_token_line: usize,
 }
 
 impl<'a> Tokens<'a> {
@@ -174,6 +176,7 @@ impl<'a> Tokens<'a> {
             text,
             pos,
             line,
+            last_token_line: line,
         }
     }
 
@@ -203,6 +206,7 @@ impl<'a> Tokens<'a> {
         while self.pos < bytes.len() && !bytes[self.pos].is_ascii_whitespace() {
             self.pos += 1;
         }
+        self.last_token_line = self.line;
         Some((&self.text[start..self.pos], self.line))
     }
 
@@ -210,7 +214,11 @@ impl<'a> Tokens<'a> {
     pub(crate) fn expect(&mut self, what: &str) -> Result<(&'a str, usize), MeshError> {
         match self.next_token() {
             Some(t) => Ok(t),
-            None => Err(self.error(format!("unexpected end of file: expected {what}"))),
+            None => Err(MeshError::at(
+                self.path,
+                self.last_token_line,
+                format!("unexpected end of file: expected {what}"),
+            )),
         }
     }
 
