@@ -1,0 +1,745 @@
+//! Bodies: adding them (mesh file, arrays, the default organ), fixing particles, and reading
+//! their state into caller buffers.
+
+use crate::body::{Body, BodyOptions, Material};
+use crate::ffi::args::{
+    all_finite, element_count, input_slice, non_null, positive, read_vec3, world_mut, world_ref,
+    write,
+};
+use crate::ffi::error::{fail, FfiResult};
+use crate::ffi::guard::guard;
+use crate::ffi::status::ts_status;
+use crate::ffi::world::ts_world;
+use crate::math::Vec3;
+use crate::mesh::{self, TetMesh};
+use crate::world::BodyId;
+use std::ffi::{c_char, CStr};
+use std::mem::MaybeUninit;
+use std::path::{Path, PathBuf};
+
+/// An isotropic linear-elastic material (SI units). ts_material_default gives liver-like tissue.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ts_material {
+    /// Young's modulus E (Pa), > 0.
+    pub youngs_modulus: f64,
+    /// Poisson ratio nu (dimensionless), in (-1, 0.5).
+    pub poisson_ratio: f64,
+    /// Mass density rho (kg/m^3), > 0.
+    pub density: f64,
+}
+
+/// Options for building a body. ts_body_options_default gives automatic radii.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ts_body_options {
+    /// Support radius of every particle (m); 0 chooses one per particle automatically.
+    pub support_radius: f64,
+    /// Contact radius of the particles (m); 0 derives it from the particle spacing.
+    pub particle_radius: f64,
+    /// Target number of neighbours when the support radius is automatic (>= 1).
+    pub target_neighbours: u32,
+}
+
+impl From<&Material> for ts_material {
+    fn from(m: &Material) -> Self {
+        ts_material {
+            youngs_modulus: m.youngs_modulus,
+            poisson_ratio: m.poisson_ratio,
+            density: m.density,
+        }
+    }
+}
+
+impl From<&BodyOptions> for ts_body_options {
+    fn from(o: &BodyOptions) -> Self {
+        ts_body_options {
+            support_radius: o.support_radius.unwrap_or(0.0),
+            particle_radius: o.particle_radius.unwrap_or(0.0),
+            target_neighbours: o.target_neighbours,
+        }
+    }
+}
+
+/// The Rust body options from the C material and (optional) options.
+///
+/// # Safety
+///
+/// `material` is NULL or readable; `options` is NULL or readable.
+unsafe fn body_options(
+    material: *const ts_material,
+    options: *const ts_body_options,
+) -> FfiResult<BodyOptions> {
+    non_null(material, "material")?;
+    // SAFETY: checked non-NULL, readable by contract; any bit pattern is a valid value.
+    let m = unsafe { *material };
+    all_finite(
+        &[m.youngs_modulus, m.poisson_ratio, m.density],
+        "material (youngs_modulus, poisson_ratio, density)",
+    )?;
+    positive(m.youngs_modulus, "material.youngs_modulus")?;
+    positive(m.density, "material.density")?;
+    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+        return Err(fail(
+            ts_status::InvalidArgument,
+            format!(
+                "material.poisson_ratio must be in (-1, 0.5) (got {})",
+                m.poisson_ratio
+            ),
+        ));
+    }
+    let mut o = BodyOptions {
+        material: Material {
+            youngs_modulus: m.youngs_modulus,
+            poisson_ratio: m.poisson_ratio,
+            density: m.density,
+        },
+        ..BodyOptions::default()
+    };
+    if !options.is_null() {
+        // SAFETY: non-NULL, readable by contract.
+        let c = unsafe { *options };
+        all_finite(
+            &[c.support_radius, c.particle_radius],
+            "options (support_radius, particle_radius)",
+        )?;
+        let radius = |v: f64, name: &str| -> FfiResult<Option<f64>> {
+            if v == 0.0 {
+                Ok(None)
+            } else {
+                positive(v, name).map(|_| Some(v))
+            }
+        };
+        o.support_radius = radius(c.support_radius, "options.support_radius")?;
+        o.particle_radius = radius(c.particle_radius, "options.particle_radius")?;
+        if c.target_neighbours == 0 {
+            return Err(fail(
+                ts_status::InvalidArgument,
+                "options.target_neighbours must be >= 1",
+            ));
+        }
+        o.target_neighbours = c.target_neighbours;
+    }
+    Ok(o)
+}
+
+/// The path named by a C string.
+///
+/// # Safety
+///
+/// `path` is NULL or a NUL-terminated string.
+pub(crate) unsafe fn c_path(path: *const c_char, name: &str) -> FfiResult<PathBuf> {
+    non_null(path, name)?;
+    // SAFETY: non-NULL and NUL-terminated by contract.
+    let bytes = unsafe { CStr::from_ptr(path) }.to_bytes();
+    if bytes.is_empty() {
+        return Err(fail(ts_status::InvalidArgument, format!("{name} is empty")));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        Ok(Path::new(std::ffi::OsStr::from_bytes(bytes)).to_path_buf())
+    }
+    #[cfg(not(unix))]
+    {
+        match std::str::from_utf8(bytes) {
+            Ok(s) => Ok(PathBuf::from(s)),
+            Err(_) => Err(fail(
+                ts_status::InvalidArgument,
+                format!("{name} is not valid UTF-8"),
+            )),
+        }
+    }
+}
+
+impl ts_world {
+    /// Add a body and remember where its particles came from.
+    fn add_mesh(
+        &mut self,
+        mesh: &TetMesh,
+        source: Vec<u32>,
+        options: &BodyOptions,
+    ) -> FfiResult<u32> {
+        let id = self.mutate(|w| w.add_body(mesh, options))?.0;
+        let slot = id as usize;
+        if self.source_indices.len() <= slot {
+            self.source_indices.resize(slot + 1, Vec::new());
+        }
+        self.source_indices[slot] = source;
+        Ok(id)
+    }
+
+    /// The body with id `body`.
+    fn body(&self, body: u32) -> FfiResult<&Body> {
+        Ok(self.world.body(BodyId(body))?)
+    }
+}
+
+/// Write the default material (liver-like: E = 5 kPa, nu = 0.45, rho = 1060 kg/m^3) into *out.
+///
+/// # Safety
+///
+/// `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_material_default(out: *mut ts_material) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out, ts_material::from(&Material::default())) };
+        Ok(())
+    })
+}
+
+/// Write the default body options (automatic support and contact radii, 20 neighbours) into
+/// *out.
+///
+/// # Safety
+///
+/// `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_options_default(out: *mut ts_body_options) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out, ts_body_options::from(&BodyOptions::default())) };
+        Ok(())
+    })
+}
+
+/// Add a deformable body from a tetrahedral mesh file: Gmsh .msh (v1, 2.2, 4.1 ASCII), TetGen
+/// .node/.ele (either file name) or legacy VTK .vtk. Node positions are multiplied by `scale`
+/// (> 0, mesh units to m). `options` is optional (NULL: defaults). A missing or malformed file
+/// gives TS_STATUS_MESH_ERROR with a message naming the file (and line). The new body's id goes
+/// to *out_body. Particles follow the file's node order, minus unreferenced nodes: see
+/// ts_body_source_indices.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `path` is NULL or NUL-terminated; `material` and `options`
+/// are NULL or readable; `out_body` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_body_from_file(
+    world: *mut ts_world,
+    path: *const c_char,
+    scale: f64,
+    material: *const ts_material,
+    options: *const ts_body_options,
+    out_body: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_body, "out_body")?;
+        // SAFETY: contract of this function.
+        let path = unsafe { c_path(path, "path")? };
+        // SAFETY: contract of this function.
+        let o = unsafe { body_options(material, options)? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        positive(scale, "scale")?;
+        let (mesh, report) = mesh::load(&path, scale)?;
+        let id = h.add_mesh(&mesh, report.original_node_index, &o)?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_body, id) };
+        Ok(())
+    })
+}
+
+/// Add a deformable body from arrays: `nodes` holds node_count x 3 doubles (x, y, z per node,
+/// m), `tets` holds tet_count x 4 node indices (0-based). Inverted tetrahedra are re-oriented,
+/// degenerate ones and unreferenced nodes removed (see ts_body_source_indices); indices out of
+/// range give TS_STATUS_MESH_ERROR, NaN/Inf coordinates TS_STATUS_NON_FINITE. `options` is
+/// optional (NULL: defaults). The new body's id goes to *out_body.
+///
+/// # Safety
+///
+/// `nodes` is NULL or holds 3 * node_count readable doubles; `tets` is NULL or holds
+/// 4 * tet_count readable uint32_t; the other pointers as in ts_world_add_body_from_file.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_body_from_arrays(
+    world: *mut ts_world,
+    nodes: *const f64,
+    node_count: usize,
+    tets: *const u32,
+    tet_count: usize,
+    material: *const ts_material,
+    options: *const ts_body_options,
+    out_body: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_body, "out_body")?;
+        let n_doubles = element_count::<f64>(node_count, 3, "node_count")?;
+        let n_indices = element_count::<u32>(tet_count, 4, "tet_count")?;
+        // SAFETY: contract of this function.
+        let xyz = unsafe { input_slice(nodes, n_doubles, "nodes")? };
+        // SAFETY: contract of this function.
+        let idx = unsafe { input_slice(tets, n_indices, "tets")? };
+        // SAFETY: contract of this function.
+        let o = unsafe { body_options(material, options)? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        all_finite(xyz, "nodes")?;
+        let nodes: Vec<Vec3> = xyz
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        let tets: Vec<[u32; 4]> = idx
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        let (mesh, report) = TetMesh::from_raw(nodes, tets, Path::new("<arrays>"))?;
+        let id = h.add_mesh(&mesh, report.original_node_index, &o)?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_body, id) };
+        Ok(())
+    })
+}
+
+/// Add the embedded default organ (a liver-like solid about 0.2 m across, generated by
+/// tissuesim, no file needed) as a body. `options` is optional (NULL: defaults). The new body's
+/// id goes to *out_body.
+///
+/// # Safety
+///
+/// As ts_world_add_body_from_file.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_default_organ(
+    world: *mut ts_world,
+    material: *const ts_material,
+    options: *const ts_body_options,
+    out_body: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_body, "out_body")?;
+        // SAFETY: contract of this function.
+        let o = unsafe { body_options(material, options)? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        let mesh = mesh::default_organ();
+        let source = (0..mesh.nodes.len() as u32).collect();
+        let id = h.add_mesh(&mesh, source, &o)?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_body, id) };
+        Ok(())
+    })
+}
+
+/// Fix the particles whose indices (count of them, 0-based particle indices) are given: they
+/// keep their current positions. An index >= the particle count gives
+/// TS_STATUS_INVALID_ARGUMENT and fixes nothing.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `indices` is NULL or holds `count` readable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_fix_particles(
+    world: *mut ts_world,
+    body: u32,
+    indices: *const u32,
+    count: usize,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let idx = unsafe { input_slice(indices, count, "indices")? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        let n = h.body(body)?.particle_count();
+        if let Some(bad) = idx.iter().find(|&&i| i as usize >= n) {
+            return Err(fail(
+                ts_status::InvalidArgument,
+                format!("indices: particle {bad} out of range (body {body} has {n} particles)"),
+            ));
+        }
+        h.mutate(|w| w.fix_particles(BodyId(body), idx))
+    })
+}
+
+/// Fix every particle whose current position lies in the axis-aligned box [min, max] (`min`
+/// and `max` are 3 doubles each, m, world frame, min <= max per axis). The number of particles
+/// fixed goes to *out_fixed, which is optional (may be NULL).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `min` and `max` are NULL or hold 3 readable doubles;
+/// `out_fixed` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_fix_box(
+    world: *mut ts_world,
+    body: u32,
+    min: *const f64,
+    max: *const f64,
+    out_fixed: *mut usize,
+) -> ts_status {
+    guard(|| {
+        non_null(min, "min")?;
+        non_null(max, "max")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        // SAFETY: checked non-NULL; 3 doubles each by contract.
+        let (lo, hi) = unsafe { (read_vec3(min), read_vec3(max)) };
+        all_finite(lo.as_slice(), "min")?;
+        all_finite(hi.as_slice(), "max")?;
+        if (0..3).any(|k| lo[k] > hi[k]) {
+            return Err(fail(
+                ts_status::InvalidArgument,
+                "min must be <= max on every axis",
+            ));
+        }
+        h.body(body)?;
+        let n = h.mutate(|w| w.fix_box(BodyId(body), lo, hi))?;
+        if !out_fixed.is_null() {
+            // SAFETY: non-NULL, writable by contract.
+            unsafe { write(out_fixed, n) };
+        }
+        Ok(())
+    })
+}
+
+/// Read one value of a body into `out`.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or writable.
+unsafe fn body_value<T>(
+    world: *const ts_world,
+    body: u32,
+    out: *mut T,
+    get: impl FnOnce(&Body) -> T,
+) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: contract of the caller.
+        let h = unsafe { world_ref(world)? };
+        let v = get(h.body(body)?);
+        // SAFETY: checked non-NULL.
+        unsafe { write(out, v) };
+        Ok(())
+    })
+}
+
+/// Write `values` into the start of `dst`.
+fn put<T>(dst: &mut [MaybeUninit<T>], values: impl Iterator<Item = T>) {
+    for (d, v) in dst.iter_mut().zip(values) {
+        d.write(v);
+    }
+}
+
+/// Copy a body's array into a caller buffer of `len` elements (nothing written when short),
+/// without allocating: `get` returns the number of elements and a function filling them.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable elements.
+#[allow(clippy::too_many_arguments)]
+unsafe fn body_array<T: Copy>(
+    world: *const ts_world,
+    body: u32,
+    out: *mut T,
+    len: usize,
+    what: &str,
+    unit: &str,
+    needed: impl FnOnce(&ts_world, &Body) -> usize,
+    fill: impl FnOnce(&ts_world, &Body, &mut [MaybeUninit<T>]),
+) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: contract of the caller.
+        let h = unsafe { world_ref(world)? };
+        let b = h.body(body)?;
+        let n = needed(h, b);
+        if len < n {
+            return Err(fail(
+                ts_status::BufferTooSmall,
+                format!("{what}: buffer holds {len} {unit}, {n} needed for body {body}"),
+            ));
+        }
+        // SAFETY: `out` holds at least `len >= n` writable (possibly uninitialised) elements by
+        // contract.
+        let dst = unsafe { std::slice::from_raw_parts_mut(out.cast::<MaybeUninit<T>>(), n) };
+        fill(h, b, dst);
+        Ok(())
+    })
+}
+
+/// Copy a body's vectors into a caller buffer of `len` doubles, without allocating.
+///
+/// # Safety
+///
+/// As [`body_array`].
+unsafe fn body_vectors(
+    world: *const ts_world,
+    body: u32,
+    out: *mut f64,
+    len: usize,
+    what: &str,
+    get: impl FnOnce(&Body) -> &[Vec3],
+) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: contract of the caller.
+        let h = unsafe { world_ref(world)? };
+        let v = get(h.body(body)?);
+        let needed = 3 * v.len();
+        if len < needed {
+            return Err(fail(
+                ts_status::BufferTooSmall,
+                format!("{what}: buffer holds {len} doubles, {needed} needed for body {body}"),
+            ));
+        }
+        // SAFETY: `out` holds at least `len >= needed` writable (possibly uninitialised)
+        // doubles by contract.
+        let dst = unsafe { std::slice::from_raw_parts_mut(out.cast::<MaybeUninit<f64>>(), needed) };
+        put(dst, v.iter().flat_map(|p| [p.x, p.y, p.z]));
+        Ok(())
+    })
+}
+
+/// Number of particles of a body (= nodes of its mesh) into *out_count.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_particle_count(
+    world: *const ts_world,
+    body: u32,
+    out_count: *mut usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_count, |b| b.particle_count()) }
+}
+
+/// Current particle positions into `out`: particle_count x 3 doubles (x, y, z per particle, m,
+/// world frame). `len` is the buffer length in doubles; below 3 * particle_count gives
+/// TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not allocate.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_positions(
+    world: *const ts_world,
+    body: u32,
+    out: *mut f64,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_vectors(world, body, out, len, "positions", |b| b.positions()) }
+}
+
+/// Current particle velocities into `out`: particle_count x 3 doubles (m/s, world frame).
+/// `len` in doubles, as ts_body_positions.
+///
+/// # Safety
+///
+/// As ts_body_positions.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_velocities(
+    world: *const ts_world,
+    body: u32,
+    out: *mut f64,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_vectors(world, body, out, len, "velocities", |b| b.velocities()) }
+}
+
+/// Rest positions into `out`: particle_count x 3 doubles (m, world frame). `len` in doubles,
+/// as ts_body_positions.
+///
+/// # Safety
+///
+/// As ts_body_positions.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_rest_positions(
+    world: *const ts_world,
+    body: u32,
+    out: *mut f64,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_vectors(world, body, out, len, "rest positions", |b| {
+            b.rest_positions()
+        })
+    }
+}
+
+/// For each particle, its 0-based index in the source the body was built from (the node order
+/// of the mesh file, or of the nodes array), into `out`: particle_count uint32_t. Use it to
+/// address file nodes (for example SOFA's fixed nodes) after unreferenced nodes were removed.
+/// `len` in uint32_t; short buffers give TS_STATUS_BUFFER_TOO_SMALL.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_source_indices(
+    world: *const ts_world,
+    body: u32,
+    out: *mut u32,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_array(
+            world,
+            body,
+            out,
+            len,
+            "source indices",
+            "uint32_t",
+            |_, b| b.particle_count(),
+            |h, b, dst| match h.source_indices.get(body as usize) {
+                Some(s) if s.len() == b.particle_count() => put(dst, s.iter().copied()),
+                _ => put(dst, 0u32..),
+            },
+        )
+    }
+}
+
+/// Number of boundary triangles of a body's tetrahedral mesh into *out_count.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_boundary_triangle_count(
+    world: *const ts_world,
+    body: u32,
+    out_count: *mut usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_count, |b| b.boundary_triangles().len()) }
+}
+
+/// Boundary triangles into `out`: triangle_count x 3 particle indices (0-based, counter-
+/// clockwise seen from outside, so normals point out). `len` in uint32_t; below
+/// 3 * triangle_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Use with
+/// ts_body_positions to render the deformed surface.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_boundary_triangles(
+    world: *const ts_world,
+    body: u32,
+    out: *mut u32,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_array(
+            world,
+            body,
+            out,
+            len,
+            "boundary triangles",
+            "uint32_t",
+            |_, b| 3 * b.boundary_triangles().len(),
+            |_, b, dst| put(dst, b.boundary_triangles().iter().flatten().copied()),
+        )
+    }
+}
+
+/// Number of tetrahedra of a body into *out_count.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_tet_count(
+    world: *const ts_world,
+    body: u32,
+    out_count: *mut usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_count, |b| b.tets().len()) }
+}
+
+/// Tetrahedra into `out`: tet_count x 4 particle indices (0-based, positively oriented). `len`
+/// in uint32_t; below 4 * tet_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_tets(
+    world: *const ts_world,
+    body: u32,
+    out: *mut u32,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_array(
+            world,
+            body,
+            out,
+            len,
+            "tets",
+            "uint32_t",
+            |_, b| 4 * b.tets().len(),
+            |_, b, dst| put(dst, b.tets().iter().flatten().copied()),
+        )
+    }
+}
+
+/// Current volume of a body (m^3, the sum of its signed tetrahedron volumes) into *out_volume.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_volume` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_volume(
+    world: *const ts_world,
+    body: u32,
+    out_volume: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_volume, |b| b.volume()) }
+}
+
+/// Rest volume of a body (m^3) into *out_volume.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_volume` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_rest_volume(
+    world: *const ts_world,
+    body: u32,
+    out_volume: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_volume, |b| b.rest_volume()) }
+}
+
+/// Largest distance of a particle of the body from its rest position (m) into *out.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_max_displacement(
+    world: *const ts_world,
+    body: u32,
+    out: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out, |b| b.max_displacement()) }
+}
+
+/// Total mass of a body (kg) into *out_mass.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_mass` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_mass(
+    world: *const ts_world,
+    body: u32,
+    out_mass: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_mass, |b| b.mass()) }
+}

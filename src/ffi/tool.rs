@@ -1,0 +1,400 @@
+//! Tools: kinematic rigid instruments (sphere, capsule, cylinder, box, OBJ mesh), their poses
+//! and the contact wrench the tissue exerts on them.
+
+use crate::collision::tool::{Pose, ToolOptions, ToolShape};
+use crate::ffi::args::{all_finite, non_negative, non_null, positive, world_mut, world_ref, write};
+use crate::ffi::body::c_path;
+use crate::ffi::error::{fail, FfiResult};
+use crate::ffi::guard::guard;
+use crate::ffi::status::ts_status;
+use crate::ffi::world::ts_world;
+use crate::math::{Quat, Vec3};
+use crate::mesh;
+use crate::world::ToolId;
+use nalgebra::Quaternion;
+use std::ffi::c_char;
+
+/// A rigid pose in the world frame: the position of the tool origin and its orientation.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ts_pose {
+    /// Position of the tool origin (m, world frame), [x, y, z].
+    pub position: [f64; 3],
+    /// Orientation as a quaternion [w, x, y, z] (local to world); normalised on use, so it
+    /// need not be unit length, but it must not be zero. Identity: {1, 0, 0, 0}.
+    pub orientation: [f64; 4],
+}
+
+impl ts_pose {
+    /// The Rust pose: NaN/Inf give TS_STATUS_NON_FINITE, a zero quaternion
+    /// TS_STATUS_INVALID_ARGUMENT; the quaternion is normalised.
+    pub fn to_pose(&self) -> FfiResult<Pose> {
+        all_finite(&self.position, "pose.position")?;
+        all_finite(&self.orientation, "pose.orientation")?;
+        let [w, x, y, z] = self.orientation;
+        let q = Quaternion::new(w, x, y, z);
+        let norm = q.norm();
+        if !(norm.is_finite() && norm > 1e-12) {
+            return Err(fail(
+                ts_status::InvalidArgument,
+                "pose.orientation: the quaternion must not be zero",
+            ));
+        }
+        Ok(Pose {
+            position: Vec3::new(self.position[0], self.position[1], self.position[2]),
+            orientation: Quat::new_unchecked(q / norm),
+        })
+    }
+}
+
+impl From<&Pose> for ts_pose {
+    fn from(p: &Pose) -> Self {
+        let q = p.orientation.quaternion();
+        ts_pose {
+            position: [p.position.x, p.position.y, p.position.z],
+            orientation: [q.w, q.i, q.j, q.k],
+        }
+    }
+}
+
+/// Options of a tool. ts_tool_options_default gives frictionless contact.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ts_tool_options {
+    /// Static friction coefficient mu_s between tool and tissue (dimensionless, >= 0).
+    pub friction_static: f64,
+    /// Kinetic friction coefficient mu_k (dimensionless, 0 <= mu_k <= mu_s).
+    pub friction_kinetic: f64,
+    /// Spacing of the surface samples in TS_CONTACT_MODE_SAMPLED_POINTS (m); 0 uses the
+    /// particle radius of the first body.
+    pub sample_spacing: f64,
+}
+
+impl From<&ToolOptions> for ts_tool_options {
+    fn from(o: &ToolOptions) -> Self {
+        ts_tool_options {
+            friction_static: o.friction_static,
+            friction_kinetic: o.friction_kinetic,
+            sample_spacing: o.sample_spacing.unwrap_or(0.0),
+        }
+    }
+}
+
+impl ts_tool_options {
+    /// The Rust options, checked.
+    pub fn to_options(&self) -> FfiResult<ToolOptions> {
+        non_negative(self.friction_static, "options.friction_static")?;
+        non_negative(self.friction_kinetic, "options.friction_kinetic")?;
+        non_negative(self.sample_spacing, "options.sample_spacing")?;
+        if self.friction_kinetic > self.friction_static {
+            return Err(fail(
+                ts_status::InvalidArgument,
+                "options.friction_kinetic must be <= options.friction_static",
+            ));
+        }
+        Ok(ToolOptions {
+            friction_static: self.friction_static,
+            friction_kinetic: self.friction_kinetic,
+            sample_spacing: (self.sample_spacing > 0.0).then_some(self.sample_spacing),
+        })
+    }
+}
+
+/// The wrench the tissue exerts on a tool, averaged over the substeps of the last step.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ts_wrench {
+    /// Force on the tool (N, world frame), [x, y, z]; feed it to a haptic device as is.
+    pub force: [f64; 3],
+    /// Torque on the tool about its origin (N m, world frame), [x, y, z].
+    pub torque: [f64; 3],
+    /// Largest penetration of a particle into the tool before projection, last step (m).
+    pub max_penetration: f64,
+    /// Number of particles in contact with the tool at the last substep.
+    pub contact_count: u32,
+}
+
+/// Add a tool of `shape` after checking the common arguments.
+///
+/// # Safety
+///
+/// Pointers as in the exported add functions.
+unsafe fn add_tool(
+    world: *mut ts_world,
+    shape: impl FnOnce() -> FfiResult<ToolShape>,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(pose, "pose")?;
+        non_null(out_tool, "out_tool")?;
+        // SAFETY: contract of the caller.
+        let h = unsafe { world_mut(world)? };
+        // SAFETY: checked non-NULL, readable by contract; every bit pattern is a valid value.
+        let pose = unsafe { *pose }.to_pose()?;
+        let options = if options.is_null() {
+            ToolOptions::default()
+        } else {
+            // SAFETY: non-NULL, readable by contract.
+            unsafe { *options }.to_options()?
+        };
+        let shape = shape()?;
+        let id = h.mutate(|w| w.add_tool(shape, pose, &options))?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_tool, id.0) };
+        Ok(())
+    })
+}
+
+/// Write the default tool options (no friction, automatic sample spacing) into *out.
+///
+/// # Safety
+///
+/// `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_options_default(out: *mut ts_tool_options) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out, ts_tool_options::from(&ToolOptions::default())) };
+        Ok(())
+    })
+}
+
+/// Add a spherical tool of `radius` (m, > 0) centred on its origin, at `pose`. `options` is
+/// optional (NULL: defaults). The new tool's id goes to *out_tool.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `pose`, `options` are NULL or readable; `out_tool` is
+/// NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_sphere(
+    world: *mut ts_world,
+    radius: f64,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    let shape = || {
+        positive(radius, "radius")?;
+        Ok(ToolShape::Sphere { radius })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a capsule tool along its local y axis: `half_height` (m, >= 0) is half the distance
+/// between the hemisphere centres, `radius` (m, > 0). Otherwise as ts_world_add_tool_sphere.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_capsule(
+    world: *mut ts_world,
+    half_height: f64,
+    radius: f64,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    let shape = || {
+        non_negative(half_height, "half_height")?;
+        positive(radius, "radius")?;
+        Ok(ToolShape::Capsule {
+            half_height,
+            radius,
+        })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a cylinder tool along its local y axis: `half_height` (m, > 0) is half its length,
+/// `radius` (m, > 0). Otherwise as ts_world_add_tool_sphere.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_cylinder(
+    world: *mut ts_world,
+    half_height: f64,
+    radius: f64,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    let shape = || {
+        positive(half_height, "half_height")?;
+        positive(radius, "radius")?;
+        Ok(ToolShape::Cylinder {
+            half_height,
+            radius,
+        })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a box tool centred on its origin: `half_extents` is 3 doubles (m, > 0 each) along its
+/// local x, y, z. Otherwise as ts_world_add_tool_sphere.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `half_extents` is NULL or holds 3 readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_box(
+    world: *mut ts_world,
+    half_extents: *const f64,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if half_extents.is_null() {
+        return guard(|| non_null(half_extents, "half_extents"));
+    }
+    let shape = || {
+        // SAFETY: non-NULL, 3 readable doubles by contract.
+        let e = unsafe { crate::ffi::args::read_vec3(half_extents) };
+        for k in 0..3 {
+            positive(e[k], &format!("half_extents[{k}]"))?;
+        }
+        Ok(ToolShape::Cuboid { half_extents: e })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a triangle-mesh tool read from a Wavefront OBJ file (`v` and `f` records), vertex
+/// positions multiplied by `scale` (> 0, file units to m), in the tool's local frame. A missing
+/// or malformed file gives TS_STATUS_MESH_ERROR naming the file. Otherwise as
+/// ts_world_add_tool_sphere.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `path` is NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_mesh_file(
+    world: *mut ts_world,
+    path: *const c_char,
+    scale: f64,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if path.is_null() {
+        return guard(|| non_null(path, "path"));
+    }
+    let shape = || {
+        // SAFETY: non-NULL and NUL-terminated by contract.
+        let path = unsafe { c_path(path, "path")? };
+        positive(scale, "scale")?;
+        let surface = mesh::read_obj(&path, scale)?;
+        Ok(ToolShape::TriMesh {
+            vertices: surface.vertices,
+            triangles: surface.triangles,
+        })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Set the pose the tool reaches at the end of the next ts_world_step (the tool moves there
+/// across the substeps of that step). NaN/Inf give TS_STATUS_NON_FINITE, a zero quaternion
+/// TS_STATUS_INVALID_ARGUMENT; the tool is unchanged on error.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `pose` is NULL or readable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_set_pose(
+    world: *mut ts_world,
+    tool: u32,
+    pose: *const ts_pose,
+) -> ts_status {
+    guard(|| {
+        non_null(pose, "pose")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        // SAFETY: checked non-NULL, readable by contract.
+        let pose = unsafe { *pose }.to_pose()?;
+        h.world.tool(ToolId(tool))?;
+        h.mutate(|w| w.set_tool_pose(ToolId(tool), pose))
+    })
+}
+
+/// The pose the tool reached at the end of the last step into *out_pose (unit quaternion).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_pose` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_get_pose(
+    world: *const ts_world,
+    tool: u32,
+    out_pose: *mut ts_pose,
+) -> ts_status {
+    guard(|| {
+        non_null(out_pose, "out_pose")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let p = ts_pose::from(&h.world.tool(ToolId(tool))?.pose());
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_pose, p) };
+        Ok(())
+    })
+}
+
+/// The contact wrench of the last step (force in N and torque in N m exerted by the tissue on
+/// the tool, world frame, averaged over the substeps; contact count) into *out_wrench.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_wrench` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_wrench(
+    world: *const ts_world,
+    tool: u32,
+    out_wrench: *mut ts_wrench,
+) -> ts_status {
+    guard(|| {
+        non_null(out_wrench, "out_wrench")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let w = h.world.tool(ToolId(tool))?.wrench();
+        let out = ts_wrench {
+            force: [w.force.x, w.force.y, w.force.z],
+            torque: [w.torque.x, w.torque.y, w.torque.z],
+            max_penetration: w.max_penetration,
+            contact_count: w.contact_count,
+        };
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_wrench, out) };
+        Ok(())
+    })
+}
+
+/// Number of particles in contact with the tool at the last substep into *out_count.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_contact_count(
+    world: *const ts_world,
+    tool: u32,
+    out_count: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_count, "out_count")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let n = h.world.tool(ToolId(tool))?.wrench().contact_count;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_count, n) };
+        Ok(())
+    })
+}

@@ -1,0 +1,387 @@
+//! `ts_world`: the opaque world handle, its settings and its step.
+
+use crate::error::Error;
+use crate::ffi::args::{all_finite, finite, non_null, world_mut, world_ref, write};
+use crate::ffi::error::{fail, FfiResult};
+use crate::ffi::guard::guard;
+use crate::ffi::status::ts_status;
+use crate::math::Vec3;
+use crate::settings::{ContactMode, Settings};
+use crate::world::World;
+
+/// How tool-tissue contact is detected (the values of ts_settings.contact_mode).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ts_contact_mode {
+    /// Exact distance from each particle to the tool's shape (the default): a smooth force.
+    ExactShape = 0,
+    /// The paper's mode: the tool surface sampled into points, particles pushed out of them.
+    SampledPoints = 1,
+}
+
+/// Parameters of the time integration and of the constraint projection (SI units). Fill it
+/// with ts_settings_default, then change fields. Integer flags are 0 (off) or non-zero (on).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ts_settings {
+    /// Time step of one ts_world_step call (s), > 0.
+    pub dt: f64,
+    /// Gravity acceleration (m/s^2), world frame, [x, y, z].
+    pub gravity: [f64; 3],
+    /// Smallest number of substeps per step (>= 1).
+    pub min_substeps: u32,
+    /// Largest number of substeps per step (>= min_substeps); the world substeps as stability
+    /// requires up to this many and reports clamping in ts_step_report.substeps_clamped.
+    pub max_substeps: u32,
+    /// Fraction (0, 1] of the explicit stability limit that a substep may use.
+    pub stability_margin: f64,
+    /// Mass-proportional (ambient) damping rate (1/s), >= 0.
+    pub damping_mass: f64,
+    /// Stiffness-proportional damping time (s), >= 0.
+    pub damping_stiffness: f64,
+    /// Hourglass-control stiffness (dimensionless, times Young's modulus), >= 0.
+    pub hourglass_stiffness: f64,
+    /// Volume compliance (1/Pa), >= 0; 0 makes every tetrahedron's volume a hard constraint.
+    pub volume_compliance: f64,
+    /// Constraint-projection iterations per substep (>= 1).
+    pub iterations: u32,
+    /// How tool-tissue contact is detected: a ts_contact_mode value.
+    pub contact_mode: u32,
+    /// Per-tetrahedron volume constraints: 0 off, non-zero on.
+    pub volume_constraints: u8,
+    /// Contact between particles of the same body: 0 off, non-zero on.
+    pub self_contact: u8,
+}
+
+impl From<&Settings> for ts_settings {
+    fn from(s: &Settings) -> Self {
+        ts_settings {
+            dt: s.dt,
+            gravity: [s.gravity.x, s.gravity.y, s.gravity.z],
+            min_substeps: s.min_substeps,
+            max_substeps: s.max_substeps,
+            stability_margin: s.stability_margin,
+            damping_mass: s.damping_mass,
+            damping_stiffness: s.damping_stiffness,
+            hourglass_stiffness: s.hourglass_stiffness,
+            volume_compliance: s.volume_compliance,
+            iterations: s.iterations,
+            contact_mode: match s.contact_mode {
+                ContactMode::ExactShape => ts_contact_mode::ExactShape as u32,
+                ContactMode::SampledPoints => ts_contact_mode::SampledPoints as u32,
+            },
+            volume_constraints: s.volume_constraints as u8,
+            self_contact: s.self_contact as u8,
+        }
+    }
+}
+
+impl ts_settings {
+    /// The Rust settings, after rejecting NaN/Inf and unknown enum values; ranges are checked
+    /// by [`Settings::validate`] where the settings are used.
+    pub fn to_settings(&self) -> FfiResult<Settings> {
+        finite(self.dt, "settings.dt")?;
+        all_finite(&self.gravity, "settings.gravity")?;
+        for (name, v) in [
+            ("settings.stability_margin", self.stability_margin),
+            ("settings.damping_mass", self.damping_mass),
+            ("settings.damping_stiffness", self.damping_stiffness),
+            ("settings.hourglass_stiffness", self.hourglass_stiffness),
+            ("settings.volume_compliance", self.volume_compliance),
+        ] {
+            finite(v, name)?;
+        }
+        let contact_mode = match self.contact_mode {
+            0 => ContactMode::ExactShape,
+            1 => ContactMode::SampledPoints,
+            m => {
+                return Err(fail(
+                    ts_status::InvalidArgument,
+                    format!("settings.contact_mode: {m} is not a ts_contact_mode"),
+                ))
+            }
+        };
+        let s = Settings {
+            dt: self.dt,
+            gravity: Vec3::new(self.gravity[0], self.gravity[1], self.gravity[2]),
+            min_substeps: self.min_substeps,
+            max_substeps: self.max_substeps,
+            stability_margin: self.stability_margin,
+            damping_mass: self.damping_mass,
+            damping_stiffness: self.damping_stiffness,
+            hourglass_stiffness: self.hourglass_stiffness,
+            volume_constraints: self.volume_constraints != 0,
+            volume_compliance: self.volume_compliance,
+            iterations: self.iterations,
+            contact_mode,
+            self_contact: self.self_contact != 0,
+        };
+        s.validate()?;
+        Ok(s)
+    }
+}
+
+/// What one ts_world_step did.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ts_step_report {
+    /// Substeps taken by the step.
+    pub substeps: u32,
+    /// 1 when stability asked for more than ts_settings.max_substeps substeps (the step ran
+    /// with max_substeps), else 0.
+    pub substeps_clamped: u32,
+}
+
+/// A simulated scene: bodies, tools and settings. Opaque; made by ts_world_new, released by
+/// ts_world_free. Used by one thread at a time; different worlds are independent.
+pub struct ts_world {
+    pub(crate) world: World,
+    /// Set while a mutation runs; stays set when it panicked.
+    poisoned: bool,
+    /// For each body id, the index in the source (file order or caller array) of each particle.
+    pub(crate) source_indices: Vec<Vec<u32>>,
+    /// Scratch buffer for saving states without reallocating.
+    pub(crate) scratch: Vec<u8>,
+}
+
+impl ts_world {
+    /// `TS_STATUS_POISONED` when an earlier mutation panicked.
+    pub(crate) fn check_poisoned(&self) -> FfiResult {
+        if self.poisoned {
+            Err(fail(
+                ts_status::Poisoned,
+                "the world is poisoned: an earlier call panicked while changing it; free it",
+            ))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Run a mutation of the world; if it panics the handle stays poisoned.
+    pub(crate) fn mutate<T>(
+        &mut self,
+        f: impl FnOnce(&mut World) -> Result<T, Error>,
+    ) -> FfiResult<T> {
+        self.poisoned = true;
+        let r = f(&mut self.world);
+        self.poisoned = false;
+        Ok(r?)
+    }
+}
+
+/// Write the default settings (1 ms step, gravity -9.81 m/s^2 along y, ...) into *out.
+///
+/// # Safety
+///
+/// `out` is NULL or points to a writable ts_settings.
+#[no_mangle]
+pub unsafe extern "C" fn ts_settings_default(out: *mut ts_settings) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        let s = ts_settings::from(&Settings::default());
+        // SAFETY: checked non-NULL; writable by contract.
+        unsafe { write(out, s) };
+        Ok(())
+    })
+}
+
+/// Create an empty world with `settings` (validated: NaN/Inf give TS_STATUS_NON_FINITE, out of
+/// range values TS_STATUS_INVALID_ARGUMENT) and store its handle in *out_world. Release it with
+/// ts_world_free.
+///
+/// # Safety
+///
+/// `settings` is NULL or points to a readable ts_settings; `out_world` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_new(
+    settings: *const ts_settings,
+    out_world: *mut *mut ts_world,
+) -> ts_status {
+    guard(|| {
+        non_null(settings, "settings")?;
+        non_null(out_world, "out_world")?;
+        // SAFETY: checked non-NULL; readable by contract; every bit pattern is a valid value.
+        let s = unsafe { *settings }.to_settings()?;
+        let world = World::new(s)?;
+        let handle = Box::new(ts_world {
+            world,
+            poisoned: false,
+            source_indices: Vec::new(),
+            scratch: Vec::new(),
+        });
+        // SAFETY: checked non-NULL; writable by contract.
+        unsafe { write(out_world, Box::into_raw(handle)) };
+        Ok(())
+    })
+}
+
+/// Release a world and everything in it. NULL is a no-op. The handle is invalid afterwards.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle from ts_world_new, not used by another thread and not
+/// freed before.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_free(world: *mut ts_world) {
+    crate::ffi::guard::guard_value((), || {
+        if !world.is_null() {
+            // SAFETY: a live handle made by Box::into_raw in ts_world_new, freed once.
+            drop(unsafe { Box::from_raw(world) });
+        }
+    })
+}
+
+/// Copy the settings in force into *out.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_get_settings(
+    world: *const ts_world,
+    out: *mut ts_settings,
+) -> ts_status {
+    guard(|| {
+        non_null(out, "out")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let s = ts_settings::from(h.world.settings());
+        // SAFETY: checked non-NULL.
+        unsafe { write(out, s) };
+        Ok(())
+    })
+}
+
+/// Replace the settings (validated as in ts_world_new; the world is unchanged on error).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `settings` is NULL or readable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_set_settings(
+    world: *mut ts_world,
+    settings: *const ts_settings,
+) -> ts_status {
+    guard(|| {
+        non_null(settings, "settings")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        // SAFETY: checked non-NULL; readable by contract.
+        let s = unsafe { *settings }.to_settings()?;
+        h.mutate(|w| w.set_settings(s))
+    })
+}
+
+/// Advance the world by settings.dt (substepping as stability requires). On
+/// TS_STATUS_DIVERGED the step produced NaN/Inf and the world was rolled back to its state
+/// before the call. `out_report` is optional (may be NULL); it is written on success only.
+/// Allocates nothing after the first step.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_report` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_step(
+    world: *mut ts_world,
+    out_report: *mut ts_step_report,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        let r = h.mutate(|w| w.step())?;
+        if !out_report.is_null() {
+            // SAFETY: non-NULL and writable by contract.
+            unsafe {
+                write(
+                    out_report,
+                    ts_step_report {
+                        substeps: r.substeps,
+                        substeps_clamped: r.substeps_clamped as u32,
+                    },
+                )
+            };
+        }
+        Ok(())
+    })
+}
+
+/// Simulated time (s) since the world was created (or of the last restored state).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_time` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_time(world: *const ts_world, out_time: *mut f64) -> ts_status {
+    guard(|| {
+        non_null(out_time, "out_time")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let t = h.world.time();
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_time, t) };
+        Ok(())
+    })
+}
+
+/// Number of bodies in the world (their ids are 0 .. count-1).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_body_count(
+    world: *const ts_world,
+    out_count: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_count, "out_count")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let n = h.world.body_count() as u32;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_count, n) };
+        Ok(())
+    })
+}
+
+/// Number of tools in the world (their ids are 0 .. count-1).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_tool_count(
+    world: *const ts_world,
+    out_count: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_count, "out_count")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let n = h.world.tool_count() as u32;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_count, n) };
+        Ok(())
+    })
+}
+
+/// Number of steps so far that produced NaN/Inf and were rolled back (TS_STATUS_DIVERGED).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_diverged_steps(
+    world: *const ts_world,
+    out_count: *mut u64,
+) -> ts_status {
+    guard(|| {
+        non_null(out_count, "out_count")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let n = h.world.diverged_steps();
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_count, n) };
+        Ok(())
+    })
+}
