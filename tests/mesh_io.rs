@@ -255,7 +255,7 @@ $EndElements\n$NodeData\n1\n\"x\"\n$EndNodeData\n";
 
 /// TetGen text of the bipyramid, numbered from `base`.
 fn bipyramid_tetgen(dir: &Path, name: &str, base: usize) -> PathBuf {
-    let mut node = format!("# bipyramid\n5 3 0 0\n");
+    let mut node = String::from("# bipyramid\n5 3 0 0\n");
     for (k, p) in BIPYRAMID_NODES.iter().enumerate() {
         node += &format!("{} {} {} {}\n", k + base, p[0], p[1], p[2]);
     }

@@ -52,7 +52,9 @@ pub(crate) fn clean(
     let mut kept: Vec<[u32; 4]> = Vec::with_capacity(tets.len());
     for (tet, &v) in tets.iter().zip(&volumes) {
         let distinct = (0..4).all(|a| (a + 1..4).all(|b| tet[a] != tet[b]));
-        if !distinct || v.abs() <= threshold || !(v.abs() > 0.0) {
+        // `v.abs() > 0.0` is false for zero and NaN volumes alike.
+        let nonzero = v.abs() > 0.0;
+        if !distinct || !nonzero || v.abs() <= threshold {
             report.degenerate_tets_removed += 1;
         } else if v < 0.0 {
             report.reoriented_tets += 1;

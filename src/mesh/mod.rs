@@ -152,6 +152,10 @@ pub fn write_vtu(
 
 /// The embedded default organ: a liver-like lobed solid about 0.2 m across, tetrahedralised
 /// by the project's own code. Needs no file.
+///
+/// It has 2,243 nodes and 9,918 tetrahedra (mean edge 0.012 m), a volume of about
+/// 1.4 × 10⁻³ m³ (1.4 L) and a bounding box of about [-0.108, 0.103] × [-0.045, 0.058] ×
+/// [-0.068, 0.068] m (x left–right, y up, z front–back). Every call returns the same bits.
 pub fn default_organ() -> TetMesh {
     organ::build_default_organ()
 }

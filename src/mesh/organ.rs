@@ -314,12 +314,43 @@ fn snap_boundary(mesh: &mut TetMesh) {
             tet_volume(p(0), p(1), p(2), p(3)) > min_volume
         })
     };
+    // Node neighbours through tet edges (CSR), for the smoothing of interior nodes.
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(mesh.tets.len() * 12);
+    for t in &mesh.tets {
+        for a in 0..4 {
+            for b in 0..4 {
+                if a != b {
+                    edges.push((t[a], t[b]));
+                }
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    let mut nstart = vec![0usize; n + 1];
+    for &(a, _) in &edges {
+        nstart[a as usize + 1] += 1;
+    }
+    for i in 0..n {
+        nstart[i + 1] += nstart[i];
+    }
+    let boundary: Vec<usize> = (0..n).filter(|&i| on_boundary[i]).collect();
+    let interior: Vec<usize> = (0..n).filter(|&i| !on_boundary[i]).collect();
+    // Move node `i` by `step`, or by a shorter step, or not at all: whatever keeps its
+    // tetrahedra healthy.
+    let try_move = |nodes: &mut Vec<Vec3>, i: usize, step: Vec3| {
+        let old = nodes[i];
+        for shrink in [1.0, 0.5, 0.25] {
+            nodes[i] = old + step * shrink;
+            if volume_ok(nodes, i, &mesh.tets) {
+                return;
+            }
+        }
+        nodes[i] = old;
+    };
     for pass in 0..SNAP_PASSES {
         let fraction = if pass + 1 == SNAP_PASSES { 1.0 } else { 0.5 };
-        for i in 0..n {
-            if !on_boundary[i] {
-                continue;
-            }
+        for &i in &boundary {
             let p = mesh.nodes[i];
             let f = organ_field(&p);
             let g = organ_gradient(&p);
@@ -333,14 +364,19 @@ fn snap_boundary(mesh: &mut TetMesh) {
             if step.norm() > limit {
                 step *= limit / step.norm();
             }
-            let old = mesh.nodes[i];
-            // Try the full step, then shorter ones.
-            for shrink in [1.0, 0.5, 0.25] {
-                mesh.nodes[i] = old + step * shrink;
-                if volume_ok(&mesh.nodes, i, &mesh.tets) {
-                    break;
-                }
-                mesh.nodes[i] = old;
+            try_move(&mut mesh.nodes, i, step);
+        }
+        // Relax the interior nodes halfway towards the mean of their neighbours, which makes
+        // room for the boundary to follow the surface in the next pass.
+        if pass + 1 < SNAP_PASSES {
+            for &i in &interior {
+                let nb = &edges[nstart[i]..nstart[i + 1]];
+                let mean = nb
+                    .iter()
+                    .fold(Vec3::zeros(), |acc, &(_, j)| acc + mesh.nodes[j as usize])
+                    / nb.len() as Real;
+                let step = (mean - mesh.nodes[i]) * 0.5;
+                try_move(&mut mesh.nodes, i, step);
             }
         }
     }
