@@ -25,16 +25,25 @@
 //! `tests/header_drift.rs`), so nothing outside `src/ffi` reaches it.
 #![allow(non_camel_case_types)]
 
-// Declaration order = order of the functions in the generated header.
-pub mod args;
-pub mod body;
-pub mod error;
-pub mod guard;
-pub mod state;
-pub mod status;
-pub mod tool;
+// Declaration order = order of the declarations in the generated header (kept apart by blank
+// lines so that rustfmt does not sort them).
 pub mod version;
+
+pub mod status;
+
+pub mod error;
+
+pub mod guard;
+
+pub mod args;
+
 pub mod world;
+
+pub mod body;
+
+pub mod tool;
+
+pub mod state;
 
 pub use body::{ts_body_options, ts_material};
 pub use status::ts_status;

@@ -104,4 +104,3 @@ pub unsafe extern "C" fn ts_world_restore_state(
         h.mutate(|w| w.restore_state(bytes))
     })
 }
-
