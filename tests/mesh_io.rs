@@ -501,6 +501,15 @@ fn bad_paths_extensions_and_scales_are_errors() {
         assert_error_at(&e, "liver.msh", None);
         assert!(mesh::read_obj(&shared("liver-smooth.obj"), scale).is_err());
     }
+    // Absurd counts in headers are errors, not allocation failures.
+    let e = load_err(&dir, "huge.msh", "$NOD\n18446744073709551615\n1 0 0 0\n");
+    assert_error_at(&e, "huge.msh", Some(3));
+    let e = load_err(
+        &dir,
+        "huge.vtk",
+        "# vtk DataFile Version 2.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 9000000000000000000 double\n0 0 0\n",
+    );
+    assert_error_at(&e, "huge.vtk", Some(6));
     let e = load_err(&dir, "empty.vtk", "");
     assert!(e.to_string().contains("empty.vtk"));
     let e = load_err(&dir, "empty.msh", "");

@@ -2,7 +2,7 @@
 //! tetrahedra (element type 4) are kept; other elements are skipped and counted. Node ids may
 //! be arbitrary and non-contiguous; nodes keep their file order.
 
-use super::parse::{read_text, Line, Lines};
+use super::parse::{prealloc, read_text, Line, Lines};
 use super::{MeshError, MeshReport, TetMesh};
 use crate::math::{Real, Vec3};
 use std::collections::HashMap;
@@ -213,7 +213,7 @@ fn read_nodes_v1(
 ) -> Result<(), MeshError> {
     raw.saw_nodes = true;
     let n = read_count(lines, "number of nodes")?;
-    raw.nodes.reserve(n);
+    raw.nodes.reserve(prealloc(n));
     for k in 0..n {
         let l = lines.expect_line(&format!("node {} of {n}", k + 1))?;
         if l.text.starts_with('$') {
@@ -326,7 +326,7 @@ fn read_nodes_v41(lines: &mut Lines<'_>, raw: &mut Raw, scale: Real) -> Result<(
         let _tag: i64 = f.next("entity tag")?;
         let parametric: u32 = f.next("parametric flag")?;
         let count: usize = f.next("number of nodes in block")?;
-        let mut tags = Vec::with_capacity(count);
+        let mut tags = Vec::with_capacity(prealloc(count));
         for k in 0..count {
             let l = lines.expect_line(&format!("node tag {} of {count}", k + 1))?;
             let mut f = l.fields();

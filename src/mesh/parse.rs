@@ -20,6 +20,12 @@ pub(crate) fn read_text(path: &Path) -> Result<String, MeshError> {
     })
 }
 
+/// How many elements to reserve for a count read from a file: the count, capped so that a
+/// corrupt header announcing billions of entries cannot exhaust memory before parsing fails.
+pub(crate) fn prealloc(declared: usize) -> usize {
+    declared.min(1 << 20)
+}
+
 /// Check that a load scale factor is finite and positive.
 pub(crate) fn check_scale(path: &Path, scale: Real) -> Result<(), MeshError> {
     if scale.is_finite() && scale > 0.0 {

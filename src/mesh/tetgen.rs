@@ -1,6 +1,6 @@
 //! TetGen `.node` / `.ele` reader (0- or 1-based numbering, detected from the first node).
 
-use super::parse::{read_text, Line, Lines};
+use super::parse::{prealloc, read_text, Line, Lines};
 use super::{MeshError, MeshReport, TetMesh};
 use crate::math::{Real, Vec3};
 use std::collections::HashMap;
@@ -57,8 +57,8 @@ fn read_node_file(path: &Path, scale: Real) -> Result<(Vec<Vec3>, HashMap<i64, u
     if n == 0 {
         return Err(header.error("the .node file declares no points"));
     }
-    let mut nodes = Vec::with_capacity(n);
-    let mut ids = HashMap::with_capacity(n);
+    let mut nodes = Vec::with_capacity(prealloc(n));
+    let mut ids = HashMap::with_capacity(prealloc(n));
     for k in 0..n {
         let line = lines.expect_line(&format!("point {} of {n}", k + 1))?;
         let mut f = line.fields();
@@ -89,7 +89,7 @@ fn read_ele_file(path: &Path, ids: &HashMap<i64, u32>) -> Result<Vec<[u32; 4]>, 
     if per != 4 && per != 10 {
         return Err(header.error(format!("nodes per tetrahedron must be 4 or 10, got {per}")));
     }
-    let mut tets = Vec::with_capacity(n);
+    let mut tets = Vec::with_capacity(prealloc(n));
     for k in 0..n {
         let line = lines.expect_line(&format!("tetrahedron {} of {n}", k + 1))?;
         let mut f = line.fields();

@@ -2,7 +2,7 @@
 //! and the `OFFSETS` / `CONNECTIVITY` layout of file version 5.x; tetrahedra, cell type 10,
 //! are kept, other cells skipped and counted) and the writer [`write_vtk`].
 
-use super::parse::{read_text, Tokens};
+use super::parse::{prealloc, read_text, Tokens};
 use super::{MeshError, MeshReport, TetMesh};
 use crate::math::{Real, Vec3};
 use std::io::Write;
@@ -94,7 +94,7 @@ pub(crate) fn read_vtk(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport)
             "POINTS" => {
                 let n: usize = tok.parse("number of points")?;
                 let _dtype = tok.expect("the point data type")?;
-                let mut p = Vec::with_capacity(n);
+                let mut p = Vec::with_capacity(prealloc(n));
                 for _ in 0..n {
                     let x = tok.parse_real("x coordinate")?;
                     let y = tok.parse_real("y coordinate")?;
@@ -117,8 +117,8 @@ pub(crate) fn read_vtk(path: &Path, scale: Real) -> Result<(TetMesh, MeshReport)
             }
             "CELL_TYPES" => {
                 let n: usize = tok.parse("number of cell types")?;
-                let mut t = Vec::with_capacity(n);
-                let mut l = Vec::with_capacity(n);
+                let mut t = Vec::with_capacity(prealloc(n));
+                let mut l = Vec::with_capacity(prealloc(n));
                 for _ in 0..n {
                     let v: u32 = tok.parse("cell type")?;
                     t.push(v);
@@ -210,8 +210,8 @@ fn read_cells_classic(
 ) -> Result<Cells, MeshError> {
     let mut cells = Cells {
         offsets: vec![0],
-        connectivity: Vec::with_capacity(size.saturating_sub(n)),
-        lines: Vec::with_capacity(n),
+        connectivity: Vec::with_capacity(prealloc(size.saturating_sub(n))),
+        lines: Vec::with_capacity(prealloc(n)),
     };
     let mut used = 0usize;
     for _ in 0..n {
@@ -244,8 +244,8 @@ fn read_cells_offsets(
     if noffsets == 0 {
         return Err(tok.error("CELLS declares 0 offsets (at least 1 is needed)"));
     }
-    let mut offsets = Vec::with_capacity(noffsets);
-    let mut offset_lines = Vec::with_capacity(noffsets);
+    let mut offsets = Vec::with_capacity(prealloc(noffsets));
+    let mut offset_lines = Vec::with_capacity(prealloc(noffsets));
     for k in 0..noffsets {
         let v: usize = tok.parse("offset")?;
         let prev = offsets.last().copied().unwrap_or(0);
@@ -269,8 +269,8 @@ fn read_cells_offsets(
         )));
     }
     let _dtype = tok.expect("the connectivity data type")?;
-    let mut connectivity = Vec::with_capacity(nconn);
-    let mut conn_lines = Vec::with_capacity(nconn);
+    let mut connectivity = Vec::with_capacity(prealloc(nconn));
+    let mut conn_lines = Vec::with_capacity(prealloc(nconn));
     for _ in 0..nconn {
         connectivity.push(cell_index(tok, npoints)?);
         conn_lines.push(tok.line());
