@@ -1,0 +1,829 @@
+//! The TissueSim model: its variable table (the single source of `modelDescription.xml` and of
+//! the compiled getters/setters) and the mapping of those variables to a [`tissuesim::World`]
+//! holding one organ and one kinematic tool.
+//!
+//! * The world is built at `fmi2ExitInitializationMode` (or when an output is read in
+//!   initialisation mode) from the parameters; the mesh is read from the FMU's `resources/`
+//!   directory (or an absolute path; `""` selects the embedded default organ).
+//! * `fmi2DoStep(t, h)` runs `n = ceil(h / internal_step)` world steps of `h / n` each and moves
+//!   the tool from the pose it had at `t` to the input pose, linearly in position and by slerp
+//!   in orientation, one interpolated pose per world step (so a long communication step never
+//!   teleports the tool into the organ).
+//! * Outputs: force and torque on the tool averaged over the communication step; contact
+//!   count, penetration, volume and displacement at its end.
+
+use crate::fmi2::bytes::{PutBytes, Reader};
+use crate::fmi2::{
+    Causality::{Input, Output, Parameter},
+    DefaultExperiment, EnumItem, EnumType, Kind, Logger, Model, ModelError, Store, UnitDefinition,
+    Value, Variability,
+    Variability::{Continuous, Discrete, Fixed, Tunable},
+    Variable,
+};
+use std::path::{Path, PathBuf};
+use tissuesim::math::Quat;
+use tissuesim::{
+    mesh, BodyId, BodyOptions, Error, Material, Pose, Settings, ToolId, ToolOptions, ToolShape,
+    Vec3, World,
+};
+
+/// Value references, one constant per variable (value reference = index in [`VARIABLES`]).
+#[allow(missing_docs)]
+pub mod vr {
+    pub const TOOL_PX: u32 = 0;
+    pub const TOOL_PY: u32 = 1;
+    pub const TOOL_PZ: u32 = 2;
+    pub const TOOL_QW: u32 = 3;
+    pub const TOOL_QX: u32 = 4;
+    pub const TOOL_QY: u32 = 5;
+    pub const TOOL_QZ: u32 = 6;
+    pub const FORCE_X: u32 = 7;
+    pub const FORCE_Y: u32 = 8;
+    pub const FORCE_Z: u32 = 9;
+    pub const TORQUE_X: u32 = 10;
+    pub const TORQUE_Y: u32 = 11;
+    pub const TORQUE_Z: u32 = 12;
+    pub const VOLUME: u32 = 13;
+    pub const VOLUME_RATIO: u32 = 14;
+    pub const CONTACT_COUNT: u32 = 15;
+    pub const MAX_DISPLACEMENT: u32 = 16;
+    pub const MAX_PENETRATION: u32 = 17;
+    pub const YOUNGS_MODULUS: u32 = 18;
+    pub const POISSON_RATIO: u32 = 19;
+    pub const DENSITY: u32 = 20;
+    pub const DAMPING: u32 = 21;
+    pub const FRICTION_STATIC: u32 = 22;
+    pub const FRICTION_KINETIC: u32 = 23;
+    pub const TOOL_SHAPE: u32 = 24;
+    pub const TOOL_RADIUS: u32 = 25;
+    pub const TOOL_HALF_LENGTH: u32 = 26;
+    pub const INTERNAL_STEP: u32 = 27;
+    pub const VOLUME_COMPLIANCE: u32 = 28;
+    pub const VOLUME_CONSTRAINTS: u32 = 29;
+    pub const MESH: u32 = 30;
+    pub const MESH_SCALE: u32 = 31;
+    pub const FIXED_MIN_X: u32 = 32;
+    pub const FIXED_MIN_Y: u32 = 33;
+    pub const FIXED_MIN_Z: u32 = 34;
+    pub const FIXED_MAX_X: u32 = 35;
+    pub const FIXED_MAX_Y: u32 = 36;
+    pub const FIXED_MAX_Z: u32 = 37;
+    pub const GRAVITY_X: u32 = 38;
+    pub const GRAVITY_Y: u32 = 39;
+    pub const GRAVITY_Z: u32 = 40;
+}
+
+/// Default tool position (m): 1 cm below the underside of the default organ's right lobe, so
+/// that the organ, hanging from its fixed top, does not touch the probe at rest.
+pub const DEFAULT_TOOL_POSITION: [f64; 3] = [0.035, -0.08, 0.0];
+/// Default fixed box (m): every node in the top ~15 % of the default organ's height.
+pub const DEFAULT_FIXED_MIN: [f64; 3] = [-0.2, 0.041, -0.2];
+/// Upper corner of the default fixed box (m).
+pub const DEFAULT_FIXED_MAX: [f64; 3] = [0.2, 0.2, 0.2];
+/// Default mesh file, inside the FMU's `resources/`.
+pub const DEFAULT_MESH: &str = "organ.vtk";
+
+/// The tool shapes (`tool_shape`).
+pub static TOOL_SHAPE_TYPE: EnumType = EnumType {
+    name: "ToolShape",
+    description: "Shape of the tool, centred on its origin, axis along its local y",
+    items: &[
+        EnumItem {
+            name: "sphere",
+            value: 0,
+            description: "sphere of radius tool_radius",
+        },
+        EnumItem {
+            name: "capsule",
+            value: 1,
+            description:
+                "capsule: segment of half length tool_half_length along local y, radius tool_radius",
+        },
+        EnumItem {
+            name: "cylinder",
+            value: 2,
+            description:
+                "cylinder of half length tool_half_length along local y, radius tool_radius",
+        },
+        EnumItem {
+            name: "box",
+            value: 3,
+            description: "box of half extents (tool_radius, tool_half_length, tool_radius)",
+        },
+    ],
+};
+
+#[allow(clippy::too_many_arguments)]
+const fn real(
+    vr: u32,
+    name: &'static str,
+    causality: crate::fmi2::Causality,
+    variability: Variability,
+    unit: &'static str,
+    start: Option<f64>,
+    min: Option<f64>,
+    description: &'static str,
+) -> Variable {
+    Variable {
+        name,
+        vr,
+        causality,
+        variability,
+        kind: Kind::Real {
+            unit,
+            start,
+            min,
+            max: None,
+        },
+        description,
+    }
+}
+
+const fn input(
+    vr: u32,
+    name: &'static str,
+    unit: &'static str,
+    start: f64,
+    d: &'static str,
+) -> Variable {
+    real(vr, name, Input, Continuous, unit, Some(start), None, d)
+}
+
+const fn output(vr: u32, name: &'static str, unit: &'static str, d: &'static str) -> Variable {
+    real(vr, name, Output, Continuous, unit, None, None, d)
+}
+
+const fn param(
+    vr: u32,
+    name: &'static str,
+    variability: Variability,
+    unit: &'static str,
+    start: f64,
+    min: Option<f64>,
+    d: &'static str,
+) -> Variable {
+    real(vr, name, Parameter, variability, unit, Some(start), min, d)
+}
+
+/// The variable table (value reference = index).
+pub static VARIABLES: &[Variable] = &[
+    input(vr::TOOL_PX, "tool_px", "m", DEFAULT_TOOL_POSITION[0], "Tool origin position x (world frame)"),
+    input(vr::TOOL_PY, "tool_py", "m", DEFAULT_TOOL_POSITION[1], "Tool origin position y (world frame, y up)"),
+    input(vr::TOOL_PZ, "tool_pz", "m", DEFAULT_TOOL_POSITION[2], "Tool origin position z (world frame)"),
+    input(vr::TOOL_QW, "tool_qw", "", 1.0, "Tool orientation quaternion w (local to world; normalised on use, must not be zero)"),
+    input(vr::TOOL_QX, "tool_qx", "", 0.0, "Tool orientation quaternion x"),
+    input(vr::TOOL_QY, "tool_qy", "", 0.0, "Tool orientation quaternion y"),
+    input(vr::TOOL_QZ, "tool_qz", "", 0.0, "Tool orientation quaternion z"),
+    output(vr::FORCE_X, "force_x", "N", "Force exerted by the tissue on the tool, x (world frame, averaged over the communication step)"),
+    output(vr::FORCE_Y, "force_y", "N", "Force exerted by the tissue on the tool, y"),
+    output(vr::FORCE_Z, "force_z", "N", "Force exerted by the tissue on the tool, z"),
+    output(vr::TORQUE_X, "torque_x", "N.m", "Torque exerted by the tissue on the tool about its origin, x (world frame, averaged over the communication step)"),
+    output(vr::TORQUE_Y, "torque_y", "N.m", "Torque on the tool about its origin, y"),
+    output(vr::TORQUE_Z, "torque_z", "N.m", "Torque on the tool about its origin, z"),
+    output(vr::VOLUME, "volume", "m3", "Current organ volume (sum of signed tetrahedron volumes) at the end of the step"),
+    output(vr::VOLUME_RATIO, "volume_ratio", "", "Organ volume / rest volume at the end of the step"),
+    Variable {
+        name: "contact_count",
+        vr: vr::CONTACT_COUNT,
+        causality: Output,
+        variability: Discrete,
+        kind: Kind::Integer {
+            start: None,
+            min: Some(0),
+            max: None,
+        },
+        description: "Number of organ particles in contact with the tool at the end of the step",
+    },
+    output(vr::MAX_DISPLACEMENT, "max_displacement", "m", "Largest distance of an organ particle from its rest position at the end of the step"),
+    output(vr::MAX_PENETRATION, "max_penetration", "m", "Largest penetration of a particle into the tool before projection, last internal step"),
+    param(vr::YOUNGS_MODULUS, "youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
+    Variable {
+        name: "poisson_ratio",
+        vr: vr::POISSON_RATIO,
+        causality: Parameter,
+        variability: Fixed,
+        kind: Kind::Real {
+            unit: "",
+            start: Some(0.45),
+            min: Some(-1.0),
+            max: Some(0.5),
+        },
+        description: "Poisson ratio nu of the organ, in (-1, 0.5)",
+    },
+    param(vr::DENSITY, "density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
+    param(vr::DAMPING, "damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
+    param(vr::FRICTION_STATIC, "friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),
+    param(vr::FRICTION_KINETIC, "friction_kinetic", Fixed, "", 0.1, Some(0.0), "Kinetic friction coefficient between tool and tissue (<= friction_static)"),
+    Variable {
+        name: "tool_shape",
+        vr: vr::TOOL_SHAPE,
+        causality: Parameter,
+        variability: Fixed,
+        kind: Kind::Enumeration {
+            ty: &TOOL_SHAPE_TYPE,
+            start: 0,
+        },
+        description: "Tool shape: 0 sphere, 1 capsule, 2 cylinder, 3 box",
+    },
+    param(vr::TOOL_RADIUS, "tool_radius", Fixed, "m", 0.01, Some(0.0), "Tool radius (sphere, capsule, cylinder) or half width (box)"),
+    param(vr::TOOL_HALF_LENGTH, "tool_half_length", Fixed, "m", 0.03, Some(0.0), "Half length of a capsule, cylinder or box along the tool's local y axis"),
+    param(vr::INTERNAL_STEP, "internal_step", Tunable, "s", 1.0e-3, Some(0.0), "Largest internal time step: fmi2DoStep(h) runs ceil(h/internal_step) world steps of equal length"),
+    param(vr::VOLUME_COMPLIANCE, "volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Compliance of the per-tetrahedron volume constraints (inverse bulk modulus); 0 = hard"),
+    Variable {
+        name: "volume_constraints",
+        vr: vr::VOLUME_CONSTRAINTS,
+        causality: Parameter,
+        variability: Tunable,
+        kind: Kind::Boolean { start: true },
+        description: "Enable the per-tetrahedron volume constraints",
+    },
+    Variable {
+        name: "mesh",
+        vr: vr::MESH,
+        causality: Parameter,
+        variability: Fixed,
+        kind: Kind::String { start: DEFAULT_MESH },
+        description: "Organ mesh: a file in the FMU's resources/ or an absolute path (.msh, .node/.ele, .vtk); empty = the embedded default organ",
+    },
+    param(vr::MESH_SCALE, "mesh_scale", Fixed, "", 1.0, Some(0.0), "Factor from mesh units to metres"),
+    param(vr::FIXED_MIN_X, "fixed_min_x", Fixed, "m", DEFAULT_FIXED_MIN[0], None, "Lower corner x of the box whose nodes are fixed (empty box: none)"),
+    param(vr::FIXED_MIN_Y, "fixed_min_y", Fixed, "m", DEFAULT_FIXED_MIN[1], None, "Lower corner y of the fixed box"),
+    param(vr::FIXED_MIN_Z, "fixed_min_z", Fixed, "m", DEFAULT_FIXED_MIN[2], None, "Lower corner z of the fixed box"),
+    param(vr::FIXED_MAX_X, "fixed_max_x", Fixed, "m", DEFAULT_FIXED_MAX[0], None, "Upper corner x of the fixed box"),
+    param(vr::FIXED_MAX_Y, "fixed_max_y", Fixed, "m", DEFAULT_FIXED_MAX[1], None, "Upper corner y of the fixed box"),
+    param(vr::FIXED_MAX_Z, "fixed_max_z", Fixed, "m", DEFAULT_FIXED_MAX[2], None, "Upper corner z of the fixed box"),
+    param(vr::GRAVITY_X, "gravity_x", Tunable, "m/s2", 0.0, None, "Gravity acceleration x"),
+    param(vr::GRAVITY_Y, "gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
+    param(vr::GRAVITY_Z, "gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
+];
+
+const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
+    UnitDefinition { name, kg, m, s }
+}
+
+/// The units of the variables, with their SI base-unit exponents.
+pub static UNITS: &[UnitDefinition] = &[
+    unit("m", 0, 1, 0),
+    unit("m3", 0, 3, 0),
+    unit("s", 0, 0, 1),
+    unit("1/s", 0, 0, -1),
+    unit("N", 1, 1, -2),
+    unit("N.m", 1, 2, -2),
+    unit("Pa", 1, -1, -2),
+    unit("1/Pa", -1, 1, 2),
+    unit("kg/m3", 1, -3, 0),
+    unit("m/s2", 0, 1, -2),
+];
+
+/// The simulation built from the parameters.
+struct Sim {
+    world: World,
+    body: BodyId,
+    tool: ToolId,
+    /// Values of the fixed parameters it was built from (a state saved with other values
+    /// needs a rebuilt world).
+    built_from: Vec<Value>,
+    /// Tool pose at the end of the last step: the start of the next interpolation.
+    pose: Pose,
+}
+
+/// The model behind the FMU (see the module documentation).
+pub struct TissueSim {
+    resources: Option<PathBuf>,
+    sim: Option<Sim>,
+    /// World state at the start of the current step, for rolling back a failed step.
+    snapshot: Vec<u8>,
+}
+
+const STATE_NO_SIM: u8 = 0;
+const STATE_SIM: u8 = 1;
+
+impl Model for TissueSim {
+    const MODEL_IDENTIFIER: &'static str = "TissueSim";
+    const DESCRIPTION: &'static str = "Real-time soft-tissue solver (point-based elasticity, position-based contact and volume conservation): a kinematic tool pressing an organ; inputs tool pose, outputs contact force/torque and organ volume";
+    const VARIABLES: &'static [Variable] = VARIABLES;
+    const UNITS: &'static [UnitDefinition] = UNITS;
+    const ENUMERATIONS: &'static [&'static EnumType] = &[&TOOL_SHAPE_TYPE];
+    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 1.0,
+        step_size: 1.0e-3,
+    };
+
+    fn new(resources: Option<PathBuf>) -> Self {
+        TissueSim {
+            resources,
+            sim: None,
+            snapshot: Vec::new(),
+        }
+    }
+
+    fn initialize(&mut self, store: &mut Store, log: &Logger) -> Result<(), ModelError> {
+        let sim = build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+        write_outputs(store, &sim, Vec3::zeros(), Vec3::zeros())?;
+        self.sim = Some(sim);
+        Ok(())
+    }
+
+    fn do_step(
+        &mut self,
+        store: &mut Store,
+        _t: f64,
+        h: f64,
+        log: &Logger,
+    ) -> Result<(), ModelError> {
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| ModelError::error("the world was not built"))?;
+        let target = pose_from_inputs(store).map_err(ModelError::error)?;
+        let n = substeps(h, store.real(vr::INTERNAL_STEP)).map_err(ModelError::error)?;
+        let dt = h / n as f64;
+        let settings = settings_from(store, sim.world.settings(), dt);
+        self.snapshot.clear();
+        sim.world.save_state(&mut self.snapshot);
+        let start_pose = sim.pose;
+        let result = run_steps(sim, &settings, start_pose, target, n, log);
+        match result {
+            Ok((force, torque)) => {
+                sim.pose = target;
+                write_outputs(store, sim, force, torque)
+            }
+            Err(e) => {
+                if let Err(r) = sim.world.restore_state(&self.snapshot) {
+                    return Err(ModelError::error(format!(
+                        "{}; rolling back also failed: {r}",
+                        e.message
+                    )));
+                }
+                Err(e)
+            }
+        }
+    }
+
+    fn reset(&mut self) {
+        self.sim = None;
+    }
+
+    fn save_state(&self, out: &mut Vec<u8>) {
+        match &self.sim {
+            None => out.put_u8(STATE_NO_SIM),
+            Some(sim) => {
+                out.put_u8(STATE_SIM);
+                let p = sim.pose.position;
+                let q = sim.pose.orientation.quaternion();
+                for v in [p.x, p.y, p.z, q.w, q.i, q.j, q.k] {
+                    out.put_f64(v);
+                }
+                let mut world = Vec::with_capacity(sim.world.state_size());
+                sim.world.save_state(&mut world);
+                out.put_blob(&world);
+            }
+        }
+    }
+
+    fn restore_state(
+        &mut self,
+        store: &Store,
+        bytes: &[u8],
+        log: &Logger,
+    ) -> Result<(), ModelError> {
+        let mut r = Reader::new(bytes);
+        let bad = |e: String| ModelError::error(format!("bad model state: {e}"));
+        match r.u8().map_err(bad)? {
+            STATE_NO_SIM => {
+                r.finish().map_err(bad)?;
+                self.sim = None;
+                Ok(())
+            }
+            STATE_SIM => {
+                let mut c = [0.0; 7];
+                for v in &mut c {
+                    *v = r.f64().map_err(bad)?;
+                }
+                let world = r.blob().map_err(bad)?;
+                r.finish().map_err(bad)?;
+                let pose = Pose {
+                    position: Vec3::new(c[0], c[1], c[2]),
+                    // Saved from a unit quaternion: restored bit for bit, not renormalised.
+                    orientation: Quat::new_unchecked(nalgebra::Quaternion::new(
+                        c[3], c[4], c[5], c[6],
+                    )),
+                };
+                let fixed = fixed_values(store);
+                let same_scene = self.sim.as_ref().is_some_and(|s| {
+                    s.built_from.len() == fixed.len()
+                        && s.built_from.iter().zip(&fixed).all(|(a, b)| a.same_bits(b))
+                });
+                if same_scene {
+                    let sim = self.sim.as_mut().expect("checked");
+                    sim.world
+                        .restore_state(world)
+                        .map_err(|e| ModelError::error(e.to_string()))?;
+                    sim.pose = pose;
+                } else {
+                    log.info(
+                        "the state was saved with other fixed parameters: rebuilding the world",
+                    );
+                    let mut sim =
+                        build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+                    sim.world
+                        .restore_state(world)
+                        .map_err(|e| ModelError::error(e.to_string()))?;
+                    sim.pose = pose;
+                    self.sim = Some(sim);
+                }
+                Ok(())
+            }
+            t => Err(bad(format!("unknown tag {t}"))),
+        }
+    }
+}
+
+/// Run `n` world steps moving the tool from `from` to `to`; the mean force and torque.
+fn run_steps(
+    sim: &mut Sim,
+    settings: &Settings,
+    from: Pose,
+    to: Pose,
+    n: u64,
+    log: &Logger,
+) -> Result<(Vec3, Vec3), ModelError> {
+    let solver = |e: Error| {
+        match e {
+        Error::Diverged(m) => ModelError::discard(format!(
+            "the solver diverged ({m}); the step was rolled back, retry with a smaller step or stiffer parameters"
+        )),
+        e => ModelError::error(e.to_string()),
+    }
+    };
+    if settings != sim.world.settings() {
+        sim.world.set_settings(settings.clone()).map_err(solver)?;
+    }
+    let mut force = Vec3::zeros();
+    let mut torque = Vec3::zeros();
+    let mut clamped = false;
+    for k in 1..=n {
+        let pose = if k == n {
+            to
+        } else {
+            interpolate(&from, &to, k as f64 / n as f64)
+        };
+        sim.world.set_tool_pose(sim.tool, pose).map_err(solver)?;
+        let report = sim.world.step().map_err(solver)?;
+        clamped |= report.substeps_clamped;
+        let w = sim.world.tool(sim.tool).map_err(solver)?.wrench();
+        force += w.force;
+        torque += w.torque;
+    }
+    if clamped {
+        log.warning(&format!(
+            "internal step {} s needed more than max_substeps = {} solver substeps for stability; ran with the maximum",
+            settings.dt, settings.max_substeps
+        ));
+    }
+    Ok((force / n as f64, torque / n as f64))
+}
+
+/// Number of internal steps for a communication step `h` and largest internal step `max_dt`:
+/// `ceil(h / max_dt)`, with ratios within 1e-9 of an integer rounded to it.
+pub fn substeps(h: f64, max_dt: f64) -> Result<u64, String> {
+    if !(max_dt.is_finite() && max_dt > 0.0) {
+        return Err(format!("internal_step = {max_dt} s must be > 0"));
+    }
+    let ratio = h / max_dt;
+    let nearest = ratio.round();
+    let n = if (ratio - nearest).abs() <= 1e-9 * ratio.max(1.0) {
+        nearest
+    } else {
+        ratio.ceil()
+    };
+    if n.is_nan() || n > 1.0e7 {
+        return Err(format!(
+            "communication step {h} s needs {n} internal steps of {max_dt} s (limit 1e7)"
+        ));
+    }
+    Ok((n as u64).max(1))
+}
+
+/// The pose of the inputs; the quaternion is normalised, a zero or tiny one is an error.
+pub fn pose_from_inputs(store: &Store) -> Result<Pose, String> {
+    let p = Vec3::new(
+        store.real(vr::TOOL_PX),
+        store.real(vr::TOOL_PY),
+        store.real(vr::TOOL_PZ),
+    );
+    let q = nalgebra::Quaternion::new(
+        store.real(vr::TOOL_QW),
+        store.real(vr::TOOL_QX),
+        store.real(vr::TOOL_QY),
+        store.real(vr::TOOL_QZ),
+    );
+    let norm = q.norm();
+    if !(norm.is_finite() && norm > 1e-9) {
+        return Err(format!(
+            "tool orientation quaternion (tool_qw, tool_qx, tool_qy, tool_qz) = ({}, {}, {}, {}) has norm {norm}: it must be a non-zero quaternion",
+            q.w, q.i, q.j, q.k
+        ));
+    }
+    Ok(Pose {
+        position: p,
+        orientation: Quat::new_normalize(q),
+    })
+}
+
+/// Pose at fraction `s` in [0, 1] from `a` to `b`: linear in position, slerp (shortest arc) in
+/// orientation; never panics (near-equal orientations fall back to normalised lerp).
+pub fn interpolate(a: &Pose, b: &Pose, s: f64) -> Pose {
+    let position = a.position + (b.position - a.position) * s;
+    let qa = a.orientation.into_inner().coords;
+    let mut qb = b.orientation.into_inner().coords;
+    let mut dot = qa.dot(&qb);
+    if dot < 0.0 {
+        qb = -qb;
+        dot = -dot;
+    }
+    let coords = if dot > 0.9995 {
+        qa * (1.0 - s) + qb * s
+    } else {
+        let theta = dot.clamp(-1.0, 1.0).acos();
+        let sin = theta.sin();
+        qa * (((1.0 - s) * theta).sin() / sin) + qb * ((s * theta).sin() / sin)
+    };
+    Pose {
+        position,
+        orientation: Quat::new_normalize(nalgebra::Quaternion::from(coords)),
+    }
+}
+
+fn fixed_values(store: &Store) -> Vec<Value> {
+    store
+        .table()
+        .iter()
+        .filter(|v| v.causality == Parameter && v.variability == Fixed)
+        .map(|v| store.get(v.vr).clone())
+        .collect()
+}
+
+/// The world settings for the tunable parameters of `store` and internal step `dt`.
+fn settings_from(store: &Store, base: &Settings, dt: f64) -> Settings {
+    let mut s = base.clone();
+    s.dt = dt;
+    s.gravity = Vec3::new(
+        store.real(vr::GRAVITY_X),
+        store.real(vr::GRAVITY_Y),
+        store.real(vr::GRAVITY_Z),
+    );
+    s.damping_mass = store.real(vr::DAMPING);
+    s.volume_compliance = store.real(vr::VOLUME_COMPLIANCE);
+    s.volume_constraints = store.boolean(vr::VOLUME_CONSTRAINTS);
+    s
+}
+
+/// The tool shape of the parameters.
+fn tool_shape(store: &Store) -> ToolShape {
+    let radius = store.real(vr::TOOL_RADIUS);
+    let half_height = store.real(vr::TOOL_HALF_LENGTH);
+    match store.integer(vr::TOOL_SHAPE) {
+        1 => ToolShape::Capsule {
+            half_height,
+            radius,
+        },
+        2 => ToolShape::Cylinder {
+            half_height,
+            radius,
+        },
+        3 => ToolShape::Cuboid {
+            half_extents: Vec3::new(radius, half_height, radius),
+        },
+        _ => ToolShape::Sphere { radius },
+    }
+}
+
+/// Where the mesh parameter points: `None` for the embedded default organ.
+pub fn mesh_path(mesh: &str, resources: Option<&Path>) -> Result<Option<PathBuf>, String> {
+    if mesh.is_empty() {
+        return Ok(None);
+    }
+    let p = Path::new(mesh);
+    if p.is_absolute() {
+        return Ok(Some(p.to_path_buf()));
+    }
+    match resources {
+        Some(dir) => Ok(Some(dir.join(p))),
+        None => Err(format!(
+            "mesh \"{mesh}\" is relative but the FMU has no usable resource location"
+        )),
+    }
+}
+
+/// Build the world from the parameters and inputs of `store`.
+fn build(store: &Store, resources: Option<&Path>, log: &Logger) -> Result<Sim, String> {
+    let scale = store.real(vr::MESH_SCALE);
+    let mesh_name = store.string(vr::MESH).to_string();
+    let organ = match mesh_path(&mesh_name, resources)? {
+        None => {
+            let mut m = mesh::default_organ();
+            for n in &mut m.nodes {
+                *n *= scale;
+            }
+            m
+        }
+        Some(path) => mesh::load(&path, scale).map_err(|e| e.to_string())?.0,
+    };
+    let settings = settings_from(store, &Settings::default(), store.real(vr::INTERNAL_STEP));
+    let e = |e: Error| e.to_string();
+    let mut world = World::new(settings).map_err(e)?;
+    let options = BodyOptions {
+        material: Material {
+            youngs_modulus: store.real(vr::YOUNGS_MODULUS),
+            poisson_ratio: store.real(vr::POISSON_RATIO),
+            density: store.real(vr::DENSITY),
+        },
+        ..BodyOptions::default()
+    };
+    let body = world.add_body(&organ, &options).map_err(e)?;
+    let min = Vec3::new(
+        store.real(vr::FIXED_MIN_X),
+        store.real(vr::FIXED_MIN_Y),
+        store.real(vr::FIXED_MIN_Z),
+    );
+    let max = Vec3::new(
+        store.real(vr::FIXED_MAX_X),
+        store.real(vr::FIXED_MAX_Y),
+        store.real(vr::FIXED_MAX_Z),
+    );
+    let fixed = if min.x <= max.x && min.y <= max.y && min.z <= max.z {
+        world.fix_box(body, min, max).map_err(e)?
+    } else {
+        0
+    };
+    let pose = pose_from_inputs(store)?;
+    let shape = tool_shape(store);
+    let tool = world
+        .add_tool(
+            shape.clone(),
+            pose,
+            &ToolOptions {
+                friction_static: store.real(vr::FRICTION_STATIC),
+                friction_kinetic: store.real(vr::FRICTION_KINETIC),
+                sample_spacing: None,
+            },
+        )
+        .map_err(e)?;
+    let b = world.body(body).map_err(e)?;
+    log.info(&format!(
+        "world built: mesh \"{mesh_name}\" ({} nodes, {} tets, rest volume {:e} m3), {fixed} nodes fixed, tool {shape:?}",
+        organ.nodes.len(),
+        organ.tets.len(),
+        b.rest_volume()
+    ));
+    if fixed == 0 && world.settings().gravity.norm() > 0.0 {
+        log.warning("no node lies in the fixed box: the organ will fall under gravity");
+    }
+    Ok(Sim {
+        world,
+        body,
+        tool,
+        built_from: fixed_values(store),
+        pose,
+    })
+}
+
+fn write_outputs(
+    store: &mut Store,
+    sim: &Sim,
+    force: Vec3,
+    torque: Vec3,
+) -> Result<(), ModelError> {
+    let e = |e: Error| ModelError::error(e.to_string());
+    let body = sim.world.body(sim.body).map_err(e)?;
+    let wrench = sim.world.tool(sim.tool).map_err(e)?.wrench();
+    let values = [
+        (vr::FORCE_X, force.x),
+        (vr::FORCE_Y, force.y),
+        (vr::FORCE_Z, force.z),
+        (vr::TORQUE_X, torque.x),
+        (vr::TORQUE_Y, torque.y),
+        (vr::TORQUE_Z, torque.z),
+        (vr::VOLUME, body.volume()),
+        (vr::VOLUME_RATIO, body.volume_ratio()),
+        (vr::MAX_DISPLACEMENT, body.max_displacement()),
+        (vr::MAX_PENETRATION, wrench.max_penetration),
+    ];
+    for (vr, v) in values {
+        store.set_real(vr, v);
+    }
+    store.set_integer(vr::CONTACT_COUNT, wrench.contact_count as i32);
+    Ok(())
+}
+
+/// The `resources/scene.txt` written into the FMU: every parameter with its default value,
+/// unit and meaning, human-readable.
+pub fn scene_text() -> String {
+    use std::fmt::Write;
+    let mut s = String::from(
+        "# TissueSim FMU: default scene (the start values of modelDescription.xml).\n\
+         # The organ mesh is resources/organ.vtk (the embedded default organ, in metres).\n\
+         # name = value [unit]  # meaning\n\n",
+    );
+    for v in VARIABLES {
+        let (value, unit) = match (v.kind, v.start_value()) {
+            (Kind::Real { unit, .. }, Value::Real(x)) => (format!("{x:?}"), unit),
+            (_, Value::Integer(x)) => (x.to_string(), ""),
+            (_, Value::Boolean(x)) => (x.to_string(), ""),
+            (_, Value::String(x)) => (format!("\"{x}\""), ""),
+            _ => unreachable!(),
+        };
+        if v.causality == Output {
+            continue;
+        }
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" [{unit}]")
+        };
+        let _ = writeln!(
+            s,
+            "{:<18} = {value}{unit}  # {} {}: {}",
+            v.name,
+            v.causality.as_str(),
+            v.variability.as_str(),
+            v.description
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi2::variables::check_table;
+
+    #[test]
+    fn table_is_consistent() {
+        check_table(VARIABLES, UNITS).unwrap();
+        assert_eq!(VARIABLES.len(), vr::GRAVITY_Z as usize + 1);
+    }
+
+    #[test]
+    fn substep_count() {
+        assert_eq!(substeps(1e-3, 1e-3).unwrap(), 1);
+        assert_eq!(substeps(0.01, 1e-3).unwrap(), 10);
+        assert_eq!(substeps(0.0105, 1e-3).unwrap(), 11);
+        assert_eq!(substeps(1e-4, 1e-3).unwrap(), 1);
+        assert_eq!(substeps(0.1 + 0.2, 0.1).unwrap(), 3);
+        assert!(substeps(1.0, 0.0).is_err());
+        assert!(substeps(1e9, 1e-3).is_err());
+    }
+
+    #[test]
+    fn interpolation() {
+        let a = Pose::at(Vec3::new(0.0, 0.0, 0.0));
+        let b = Pose {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            orientation: Quat::from_axis_angle(&Vec3::y_axis(), std::f64::consts::PI),
+        };
+        let m = interpolate(&a, &b, 0.5);
+        assert!((m.position - Vec3::new(0.5, 1.0, 1.5)).norm() < 1e-15);
+        assert!((m.orientation.angle() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!(
+            (interpolate(&a, &b, 1.0)
+                .orientation
+                .angle_to(&b.orientation))
+                < 1e-12
+        );
+        // Antipodal quaternions (the same rotation) do not panic and stay put.
+        let c = Pose {
+            position: Vec3::zeros(),
+            orientation: Quat::new_unchecked(-a.orientation.into_inner()),
+        };
+        assert!(interpolate(&a, &c, 0.3).orientation.angle() < 1e-12);
+    }
+
+    #[test]
+    fn zero_quaternion_is_refused() {
+        let mut store = Store::new(VARIABLES);
+        assert!(pose_from_inputs(&store).is_ok());
+        store.set_real(vr::TOOL_QW, 0.0);
+        assert!(pose_from_inputs(&store).unwrap_err().contains("non-zero"));
+        store.set_real(vr::TOOL_QZ, 2.0);
+        let p = pose_from_inputs(&store).unwrap();
+        assert!((p.orientation.quaternion().norm() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn mesh_resolution() {
+        let res = Path::new("/fmu/resources");
+        assert_eq!(mesh_path("", Some(res)).unwrap(), None);
+        assert_eq!(
+            mesh_path("organ.vtk", Some(res)).unwrap(),
+            Some(PathBuf::from("/fmu/resources/organ.vtk"))
+        );
+        assert_eq!(
+            mesh_path("/abs/liver.msh", None).unwrap(),
+            Some(PathBuf::from("/abs/liver.msh"))
+        );
+        assert!(mesh_path("organ.vtk", None).is_err());
+    }
+}
