@@ -385,3 +385,39 @@ pub unsafe extern "C" fn ts_world_diverged_steps(
         Ok(())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::ptr::null_mut;
+
+    /// A panic inside a mutation becomes TS_STATUS_PANIC and poisons the world: every later
+    /// call returns TS_STATUS_POISONED, and ts_world_free still releases it.
+    #[test]
+    fn a_panicking_mutation_poisons_the_world() {
+        let mut s = ts_settings::from(&Settings::default());
+        let mut w = null_mut();
+        assert_eq!(unsafe { ts_world_new(&s, &mut w) }, ts_status::Ok);
+        let st = guard(|| {
+            // SAFETY: a live handle.
+            let h = unsafe { world_mut(w)? };
+            h.mutate(|_| -> Result<(), Error> { panic!("half-way through a change") })
+        });
+        assert_eq!(st, ts_status::Panic);
+        assert!(crate::ffi::error::last_error().contains("half-way"));
+        assert_eq!(unsafe { ts_world_step(w, null_mut()) }, ts_status::Poisoned);
+        let mut t = 0.0;
+        assert_eq!(unsafe { ts_world_time(w, &mut t) }, ts_status::Poisoned);
+        assert_eq!(unsafe { ts_world_set_settings(w, &s) }, ts_status::Poisoned);
+        assert_eq!(
+            unsafe { ts_world_get_settings(w, &mut s) },
+            ts_status::Poisoned
+        );
+        assert_eq!(
+            unsafe { crate::ffi::state::ts_world_restore_state(w, [0u8].as_ptr(), 1) },
+            ts_status::Poisoned
+        );
+        assert!(crate::ffi::error::last_error().contains("poisoned"));
+        unsafe { ts_world_free(w) };
+    }
+}
