@@ -73,11 +73,11 @@ pub mod vr {
     pub const GRAVITY_Z: u32 = 40;
 }
 
-/// Default tool position (m): 1 cm below the underside of the default organ's right lobe, so
+/// Default tool position (m): 2 cm below the underside of the default organ's right lobe, so
 /// that the organ, hanging from its fixed top, does not touch the probe at rest.
-pub const DEFAULT_TOOL_POSITION: [f64; 3] = [0.035, -0.08, 0.0];
+pub const DEFAULT_TOOL_POSITION: [f64; 3] = [0.035, -0.07, 0.0];
 /// Default fixed box (m): every node in the top ~15 % of the default organ's height.
-pub const DEFAULT_FIXED_MIN: [f64; 3] = [-0.2, 0.041, -0.2];
+pub const DEFAULT_FIXED_MIN: [f64; 3] = [-0.2, 0.043, -0.2];
 /// Upper corner of the default fixed box (m).
 pub const DEFAULT_FIXED_MAX: [f64; 3] = [0.2, 0.2, 0.2];
 /// Default mesh file, inside the FMU's `resources/`.
@@ -825,5 +825,50 @@ mod tests {
             Some(PathBuf::from("/abs/liver.msh"))
         );
         assert!(mesh_path("organ.vtk", None).is_err());
+    }
+}
+
+#[cfg(test)]
+mod default_scene {
+    use super::*;
+
+    /// The start values fit the default organ: the probe lies below it, clear of it, right under
+    /// tissue; the fixed box holds the top ~15 % of its height.
+    #[test]
+    fn start_values_fit_the_default_organ() {
+        let organ = mesh::default_organ();
+        let (lo, hi) = organ.bounding_box();
+        eprintln!(
+            "default organ: {} nodes, bbox {lo:?} .. {hi:?}",
+            organ.nodes.len()
+        );
+        let probe = Vec3::from(DEFAULT_TOOL_POSITION);
+        let radius = 0.01;
+        let clearance = organ
+            .nodes
+            .iter()
+            .map(|n| (n - probe).norm())
+            .fold(f64::MAX, f64::min)
+            - radius;
+        eprintln!("probe clearance {clearance} m");
+        assert!(
+            clearance > 0.005 && clearance < 0.03,
+            "clearance {clearance}"
+        );
+        assert!(probe.y < lo.y);
+        let above = organ
+            .nodes
+            .iter()
+            .filter(|n| ((n.x - probe.x).powi(2) + (n.z - probe.z).powi(2)).sqrt() < radius)
+            .count();
+        assert!(above > 0, "no tissue above the probe");
+        let height = hi.y - lo.y;
+        let fixed_fraction = (hi.y - DEFAULT_FIXED_MIN[1]) / height;
+        eprintln!("fixed top fraction {fixed_fraction}");
+        assert!((0.1..=0.2).contains(&fixed_fraction));
+        for k in [0, 2] {
+            assert!(DEFAULT_FIXED_MIN[k] < lo[k] && DEFAULT_FIXED_MAX[k] > hi[k]);
+        }
+        assert!(DEFAULT_FIXED_MAX[1] > hi.y);
     }
 }

@@ -664,3 +664,259 @@ fn fnv1a_128(bytes: &[u8]) -> u128 {
         .iter()
         .fold(OFFSET, |h, &b| (h ^ b as u128).wrapping_mul(PRIME))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi2::variables::{
+        Causality::{Input, Output, Parameter},
+        Kind,
+        Variability::{Continuous, Fixed, Tunable},
+    };
+
+    /// A toy model: `y += k * u * h` per step; `k` fixed, `g` tunable; fails on `u > 100`.
+    struct Toy {
+        y: f64,
+        built: bool,
+    }
+
+    const fn r(
+        vr: u32,
+        name: &'static str,
+        c: Causality,
+        v: crate::fmi2::Variability,
+        start: Option<f64>,
+    ) -> Variable {
+        Variable {
+            name,
+            vr,
+            causality: c,
+            variability: v,
+            kind: Kind::Real {
+                unit: "",
+                start,
+                min: None,
+                max: None,
+            },
+            description: "",
+        }
+    }
+
+    static TOY_VARS: &[Variable] = &[
+        r(0, "u", Input, Continuous, Some(1.0)),
+        r(1, "y", Output, Continuous, None),
+        r(2, "k", Parameter, Fixed, Some(2.0)),
+        r(3, "g", Parameter, Tunable, Some(0.0)),
+        Variable {
+            name: "s",
+            vr: 4,
+            causality: Parameter,
+            variability: Fixed,
+            kind: Kind::String { start: "abc" },
+            description: "",
+        },
+    ];
+
+    impl Model for Toy {
+        const MODEL_IDENTIFIER: &'static str = "Toy";
+        const DESCRIPTION: &'static str = "toy";
+        const VARIABLES: &'static [Variable] = TOY_VARS;
+        const UNITS: &'static [UnitDefinition] = &[];
+        const ENUMERATIONS: &'static [&'static EnumType] = &[];
+        const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
+            start_time: 0.0,
+            stop_time: 1.0,
+            step_size: 0.1,
+        };
+        fn new(_: Option<PathBuf>) -> Self {
+            Toy {
+                y: 0.0,
+                built: false,
+            }
+        }
+        fn initialize(&mut self, store: &mut Store, _: &Logger) -> Result<(), ModelError> {
+            self.built = true;
+            self.y = store.real(2);
+            store.set_real(1, self.y);
+            Ok(())
+        }
+        fn do_step(
+            &mut self,
+            store: &mut Store,
+            _t: f64,
+            h: f64,
+            _: &Logger,
+        ) -> Result<(), ModelError> {
+            let u = store.real(0);
+            if u > 100.0 {
+                return Err(ModelError::discard("u too large"));
+            }
+            self.y += store.real(2) * u * h + store.real(3);
+            store.set_real(1, self.y);
+            Ok(())
+        }
+        fn reset(&mut self) {
+            *self = Toy::new(None);
+        }
+        fn save_state(&self, out: &mut Vec<u8>) {
+            out.put_u8(self.built as u8);
+            out.put_f64(self.y);
+        }
+        fn restore_state(&mut self, _: &Store, b: &[u8], _: &Logger) -> Result<(), ModelError> {
+            let mut r = Reader::new(b);
+            let built = r.u8().map_err(ModelError::error)? != 0;
+            let y = r.f64().map_err(ModelError::error)?;
+            r.finish().map_err(ModelError::error)?;
+            self.built = built;
+            self.y = y;
+            Ok(())
+        }
+    }
+
+    fn toy() -> Instance<Toy> {
+        Instance::new(Logger::new(None, std::ptr::null_mut(), "toy", false), None)
+    }
+
+    fn get(i: &mut Instance<Toy>, vr: u32) -> f64 {
+        i.prepare_get("get", BaseType::Real, &[vr]).unwrap();
+        i.store().real(vr)
+    }
+
+    fn set(i: &mut Instance<Toy>, vr: u32, v: f64) -> Fmi2Status {
+        i.set("set", BaseType::Real, &[vr], vec![Value::Real(v)])
+    }
+
+    fn initialised() -> Instance<Toy> {
+        let mut i = toy();
+        i.setup_experiment(0.0, Some(10.0)).unwrap();
+        i.enter_initialization_mode().unwrap();
+        i.exit_initialization_mode().unwrap();
+        i
+    }
+
+    #[test]
+    fn normal_sequence() {
+        let mut i = toy();
+        assert_eq!(i.state(), State::Instantiated);
+        assert_eq!(set(&mut i, 2, 3.0), Fmi2Status::Ok);
+        i.setup_experiment(1.0, None).unwrap();
+        i.enter_initialization_mode().unwrap();
+        // Outputs are computed when read in initialisation mode.
+        assert_eq!(get(&mut i, 1), 3.0);
+        assert_eq!(set(&mut i, 2, 4.0), Fmi2Status::Ok);
+        assert_eq!(get(&mut i, 1), 4.0);
+        i.exit_initialization_mode().unwrap();
+        assert_eq!(i.state(), State::StepComplete);
+        assert_eq!(i.do_step(1.0, 0.5), Fmi2Status::Ok);
+        assert_eq!(get(&mut i, 1), 4.0 + 4.0 * 0.5);
+        assert_eq!(i.time(), 1.5);
+        i.terminate().unwrap();
+        assert_eq!(i.state(), State::Terminated);
+        assert_eq!(get(&mut i, 1), 6.0);
+        i.reset().unwrap();
+        assert_eq!(i.state(), State::Instantiated);
+        assert_eq!(i.store().real(2), 2.0);
+    }
+
+    #[test]
+    fn illegal_call_sequences_change_nothing() {
+        let mut i = toy();
+        assert_eq!(i.do_step(0.0, 0.1), Fmi2Status::Error);
+        assert!(i.exit_initialization_mode().is_err());
+        assert!(i.terminate().is_err());
+        assert!(i.prepare_get("fmi2GetReal", BaseType::Real, &[1]).is_err());
+        assert_eq!(i.state(), State::Instantiated);
+        let mut i = initialised();
+        assert!(i.setup_experiment(0.0, None).is_err());
+        assert!(i.enter_initialization_mode().is_err());
+        assert!(i.exit_initialization_mode().is_err());
+        assert_eq!(i.state(), State::StepComplete);
+        i.terminate().unwrap();
+        assert_eq!(i.do_step(0.0, 0.1), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 0, 1.0), Fmi2Status::Error);
+        assert_eq!(i.state(), State::Terminated);
+    }
+
+    #[test]
+    fn set_checks_are_atomic() {
+        let mut i = initialised();
+        // Fixed parameter after initialisation, output, unknown reference, wrong type, NaN.
+        assert_eq!(set(&mut i, 2, 5.0), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 1, 5.0), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 99, 5.0), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 4, 5.0), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 0, f64::NAN), Fmi2Status::Error);
+        assert_eq!(set(&mut i, 0, f64::INFINITY), Fmi2Status::Error);
+        let s = i.set(
+            "fmi2SetReal",
+            BaseType::Real,
+            &[0, 0],
+            vec![Value::Real(7.0), Value::Real(f64::NAN)],
+        );
+        assert_eq!(s, Fmi2Status::Error);
+        assert_eq!(i.store().real(0), 1.0, "nothing set by a refused call");
+        // Tunable parameters and inputs are settable while stepping.
+        assert_eq!(set(&mut i, 3, 0.5), Fmi2Status::Ok);
+        assert_eq!(set(&mut i, 0, 2.0), Fmi2Status::Ok);
+        assert!(i.prepare_get("g", BaseType::Real, &[77]).is_err());
+        assert!(i.prepare_get("g", BaseType::Integer, &[0]).is_err());
+        assert_eq!(i.state(), State::StepComplete);
+    }
+
+    #[test]
+    fn step_arguments_are_checked() {
+        let mut i = initialised();
+        assert_eq!(i.do_step(0.0, 0.0), Fmi2Status::Error);
+        assert_eq!(i.do_step(0.0, -1.0), Fmi2Status::Error);
+        assert_eq!(i.do_step(0.0, f64::NAN), Fmi2Status::Error);
+        assert_eq!(i.do_step(0.5, 0.1), Fmi2Status::Error, "wrong time");
+        assert_eq!(i.do_step(0.0, 11.0), Fmi2Status::Error, "beyond stop time");
+        assert_eq!(set(&mut i, 0, 1000.0), Fmi2Status::Ok);
+        assert_eq!(i.do_step(0.0, 0.1), Fmi2Status::Discard);
+        assert_eq!(i.time(), 0.0);
+        assert_eq!(set(&mut i, 0, 1.0), Fmi2Status::Ok);
+        assert_eq!(i.do_step(0.0, 0.1), Fmi2Status::Ok);
+        assert_eq!(i.state(), State::StepComplete);
+    }
+
+    #[test]
+    fn fmu_state_round_trip() {
+        let mut a = initialised();
+        assert_eq!(a.do_step(0.0, 0.25), Fmi2Status::Ok);
+        let mut bytes = Vec::new();
+        a.save_fmu_state(&mut bytes).unwrap();
+        assert_eq!(a.do_step(0.25, 0.25), Fmi2Status::Ok);
+        let y1 = get(&mut a, 1);
+        a.restore_fmu_state(&bytes).unwrap();
+        assert_eq!(a.time(), 0.25);
+        assert_eq!(a.do_step(0.25, 0.25), Fmi2Status::Ok);
+        assert_eq!(get(&mut a, 1).to_bits(), y1.to_bits());
+        // Into a fresh instance still in state instantiated.
+        let mut b = toy();
+        b.restore_fmu_state(&bytes).unwrap();
+        assert_eq!(b.state(), State::StepComplete);
+        assert_eq!(b.do_step(0.25, 0.25), Fmi2Status::Ok);
+        assert_eq!(get(&mut b, 1).to_bits(), y1.to_bits());
+        // Corrupted states are refused and change nothing.
+        let mut bad = bytes.clone();
+        bad[0] ^= 1;
+        assert!(b.restore_fmu_state(&bad).is_err());
+        assert!(b.restore_fmu_state(&bytes[..bytes.len() - 1]).is_err());
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(b.restore_fmu_state(&longer).is_err());
+        let mut version = bytes.clone();
+        version[8] = 99;
+        assert!(b.restore_fmu_state(&version).is_err());
+        assert_eq!(b.time(), 0.5);
+    }
+
+    #[test]
+    fn guid_is_stable_and_well_formed() {
+        let g = guid::<Toy>();
+        assert_eq!(g, guid::<Toy>());
+        assert_eq!(g.len(), 38);
+        assert!(g.starts_with('{') && g.ends_with('}'));
+        assert_eq!(g.matches('-').count(), 4);
+    }
+}
