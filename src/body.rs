@@ -1,7 +1,12 @@
 //! A deformable body: particles at the mesh nodes, their neighbourhoods with the rest-state
 //! quantities precomputed, the tetrahedra for volume conservation, and the material.
 
-use crate::math::{Real, Vec3};
+use crate::elastic::{self, ElasticModel, ForceInputs};
+use crate::error::Error;
+use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
+use crate::mesh::TetMesh;
+use crate::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::settings::Settings;
 
 /// An isotropic linear-elastic material (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,12 +56,145 @@ impl Default for BodyOptions {
 }
 
 /// A deformable body (see the module documentation).
+///
+/// Data are laid out as flat arrays (one entry per particle, per pair in CSR, per tetrahedron)
+/// so that the step streams through memory and allocates nothing.
 #[derive(Debug, Clone)]
 pub struct Body {
+    pub(crate) material: Material,
+    pub(crate) model: ElasticModel,
+    /// Rest positions (m).
+    pub(crate) rest: Vec<Vec3>,
+    /// Positions (m).
     pub(crate) x: Vec<Vec3>,
+    /// Velocities (m/s).
+    pub(crate) v: Vec<Vec3>,
+    /// Predicted positions of the current substep (m); scratch.
+    pub(crate) p: Vec<Vec3>,
+    /// Forces of the current substep (N); scratch.
+    pub(crate) force: Vec<Vec3>,
+    /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
+    pub(crate) mass: Vec<Real>,
+    /// Inertial masses (kg): the physical mass plus any mass scaling.
+    pub(crate) inertial_mass: Vec<Real>,
+    /// Inverse inertial masses (1/kg), 0 for fixed particles.
+    pub(crate) inv_mass: Vec<Real>,
+    /// Fixed flags.
+    pub(crate) fixed: Vec<bool>,
+    /// Particle volumes (m³).
+    pub(crate) particle_volume: Vec<Real>,
+    /// Per-particle rotation of the corotated model, warm start of the next extraction.
+    pub(crate) rotation: Vec<Quat>,
+    pub(crate) nbr: Neighbourhoods,
+    pub(crate) tets: Vec<[u32; 4]>,
+    /// Tetrahedron rest volumes (m³).
+    pub(crate) tet_rest_volume: Vec<Real>,
+    /// XPBD multipliers of the volume constraints within a substep; scratch.
+    pub(crate) tet_lambda: Vec<Real>,
+    pub(crate) boundary: Vec<[u32; 3]>,
+    pub(crate) particle_radius: Real,
+    pub(crate) rest_volume: Real,
+    /// Largest angular frequency of the linearised elastic system at rest (rad/s).
+    pub(crate) omega_max: Real,
+    /// Copies of `x`, `v`, `rotation` taken at the start of a step, restored if it diverges.
+    pub(crate) saved_x: Vec<Vec3>,
+    pub(crate) saved_v: Vec<Vec3>,
+    pub(crate) saved_rotation: Vec<Quat>,
 }
 
+/// Rotation-extraction iterations per particle per substep (warm-started, so 1–3 suffice).
+pub(crate) const ROTATION_ITERATIONS: u32 = 4;
+
 impl Body {
+    /// Build a body from a cleaned mesh (positions in m) under the world's `settings`.
+    pub(crate) fn new(
+        mesh: &TetMesh,
+        options: &BodyOptions,
+        settings: &Settings,
+    ) -> Result<Body, Error> {
+        let m = &options.material;
+        let bad = |s: String| Err(Error::InvalidArgument(s));
+        if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
+            return bad(format!("Young's modulus must be > 0 Pa, got {}", m.youngs_modulus));
+        }
+        if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+            return bad(format!("Poisson ratio must be in (-1, 0.5), got {}", m.poisson_ratio));
+        }
+        if !(m.density.is_finite() && m.density > 0.0) {
+            return bad(format!("density must be > 0 kg/m3, got {}", m.density));
+        }
+        for r in [options.support_radius, options.particle_radius].into_iter().flatten() {
+            if !(r.is_finite() && r > 0.0) {
+                return bad(format!("radii must be finite and > 0 m, got {r}"));
+            }
+        }
+        let n = mesh.nodes.len();
+        if mesh.tets.is_empty() || n < 5 {
+            return bad("a body needs at least one tetrahedron and 5 nodes".into());
+        }
+        if let Some(k) = mesh.nodes.iter().position(|p| !is_finite_vec(p)) {
+            return Err(Error::NonFinite(format!("mesh node {k}")));
+        }
+        let mut particle_volume = vec![0.0; n];
+        let mut tet_rest_volume = Vec::with_capacity(mesh.tets.len());
+        for (t, tet) in mesh.tets.iter().enumerate() {
+            if tet.iter().any(|&k| k as usize >= n) {
+                return bad(format!("tetrahedron {t} references a node out of range"));
+            }
+            let [a, b, c, d] = tet.map(|k| mesh.nodes[k as usize]);
+            let vol = tet_volume(&a, &b, &c, &d);
+            if vol <= 0.0 {
+                return bad(format!("tetrahedron {t} is not positively oriented"));
+            }
+            tet_rest_volume.push(vol);
+            for &k in tet {
+                particle_volume[k as usize] += 0.25 * vol;
+            }
+        }
+        if let Some(k) = particle_volume.iter().position(|&v| v <= 0.0) {
+            return bad(format!("node {k} belongs to no tetrahedron"));
+        }
+        let support = match options.support_radius {
+            Some(h) => SupportRadius::Fixed(h),
+            None => SupportRadius::Automatic {
+                target: options.target_neighbours as usize,
+            },
+        };
+        let nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
+        let mass: Vec<Real> = particle_volume.iter().map(|v| v * m.density).collect();
+        let particle_radius = options
+            .particle_radius
+            .unwrap_or_else(|| 0.5 * mesh.mean_edge_length());
+        let mut body = Body {
+            material: *m,
+            model: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
+            rest: mesh.nodes.clone(),
+            x: mesh.nodes.clone(),
+            v: vec![Vec3::zeros(); n],
+            p: mesh.nodes.clone(),
+            force: vec![Vec3::zeros(); n],
+            inv_mass: vec![0.0; n],
+            inertial_mass: mass.clone(),
+            mass,
+            fixed: vec![false; n],
+            particle_volume,
+            rotation: vec![Quat::identity(); n],
+            nbr,
+            rest_volume: tet_rest_volume.iter().sum(),
+            tet_lambda: vec![0.0; mesh.tets.len()],
+            tet_rest_volume,
+            tets: mesh.tets.clone(),
+            boundary: mesh.boundary_triangles(),
+            particle_radius,
+            omega_max: 0.0,
+            saved_x: mesh.nodes.clone(),
+            saved_v: vec![Vec3::zeros(); n],
+            saved_rotation: vec![Quat::identity(); n],
+        };
+        body.configure(settings);
+        Ok(body)
+    }
+
     /// Number of particles (= mesh nodes).
     pub fn particle_count(&self) -> usize {
         self.x.len()
@@ -67,27 +205,44 @@ impl Body {
     }
     /// Current particle velocities (m/s), one per particle.
     pub fn velocities(&self) -> &[Vec3] {
-        todo!()
+        &self.v
     }
     /// Rest positions (m), one per particle.
     pub fn rest_positions(&self) -> &[Vec3] {
-        todo!()
+        &self.rest
+    }
+    /// Physical particle masses `ρ v_i` (kg), one per particle: gravity acts on these.
+    pub fn masses(&self) -> &[Real] {
+        &self.mass
+    }
+    /// Inertial particle masses (kg), one per particle: the physical mass plus the mass added
+    /// by [`Settings::mass_scaling`]. Momentum is `Σ inertial_mass · v`.
+    pub fn inertial_masses(&self) -> &[Real] {
+        &self.inertial_mass
+    }
+    /// Total inertial mass added by mass scaling (kg).
+    pub fn added_mass(&self) -> Real {
+        self.inertial_mass.iter().sum::<Real>() - self.mass()
     }
     /// Tetrahedra (4 particle indices each).
     pub fn tets(&self) -> &[[u32; 4]] {
-        todo!()
+        &self.tets
     }
     /// Boundary triangles of the tetrahedral mesh (3 particle indices each, outward normals).
     pub fn boundary_triangles(&self) -> &[[u32; 3]] {
-        todo!()
+        &self.boundary
+    }
+    /// The neighbourhoods and their rest-state quantities.
+    pub fn neighbourhoods(&self) -> &Neighbourhoods {
+        &self.nbr
     }
     /// Current volume (m³): the sum of the signed tetrahedron volumes.
     pub fn volume(&self) -> Real {
-        todo!()
+        volume_of(&self.x, &self.tets)
     }
     /// Rest volume (m³).
     pub fn rest_volume(&self) -> Real {
-        todo!()
+        self.rest_volume
     }
     /// `volume() / rest_volume()` (dimensionless).
     pub fn volume_ratio(&self) -> Real {
@@ -95,23 +250,133 @@ impl Body {
     }
     /// Largest distance of a particle from its rest position (m).
     pub fn max_displacement(&self) -> Real {
-        todo!()
+        self.x
+            .iter()
+            .zip(&self.rest)
+            .map(|(x, r)| (x - r).norm())
+            .fold(0.0, Real::max)
     }
-    /// True when particle `i` is fixed.
+    /// True when particle `i` is fixed (false for an index out of range).
     pub fn is_fixed(&self, i: usize) -> bool {
-        let _ = i;
-        todo!()
+        self.fixed.get(i).copied().unwrap_or(false)
     }
     /// Contact radius of the particles (m).
     pub fn particle_radius(&self) -> Real {
-        todo!()
+        self.particle_radius
     }
     /// Total mass (kg).
     pub fn mass(&self) -> Real {
-        todo!()
+        self.mass.iter().sum()
     }
     /// The material.
     pub fn material(&self) -> &Material {
-        todo!()
+        &self.material
     }
+    /// Largest angular frequency (rad/s) of the body's linearised elastic vibrations at rest,
+    /// the quantity that sets the explicit stability limit `2/ω_max` of a substep.
+    pub fn max_angular_frequency(&self) -> Real {
+        self.omega_max
+    }
+
+    /// Deformation gradient of particle `i` if the particles were at `positions` (m).
+    pub fn deformation_gradient_at(&self, positions: &[Vec3], i: usize) -> Mat3 {
+        elastic::deformation_gradient(&self.nbr, positions, i)
+    }
+
+    /// Elastic (and hourglass) forces (N) on every particle if the particles were at
+    /// `positions` (m) with zero velocity; an analysis helper that allocates.
+    pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
+        let mut force = vec![Vec3::zeros(); self.x.len()];
+        let mut rotation = vec![Quat::identity(); self.x.len()];
+        let zero = vec![Vec3::zeros(); self.x.len()];
+        let input = ForceInputs {
+            nbr: &self.nbr,
+            volume: &self.particle_volume,
+            x: positions,
+            v: &zero,
+        };
+        elastic::accumulate_forces(&self.model, &input, &mut rotation, 50, &mut force);
+        force
+    }
+
+    /// Apply the world's settings: the elastic model's hourglass and damping terms, the mass
+    /// scaling for substeps of `dt / min_substeps`, and the stability estimate.
+    pub(crate) fn configure(&mut self, settings: &Settings) {
+        let m = self.material;
+        self.model = ElasticModel::new(
+            m.youngs_modulus,
+            m.poisson_ratio,
+            settings.hourglass_stiffness,
+            settings.damping_stiffness,
+        );
+        self.inertial_mass.copy_from_slice(&self.mass);
+        self.update_inverse_masses();
+        self.omega_max = crate::stability::max_angular_frequency(self);
+        if settings.mass_scaling {
+            let h = settings.dt / settings.min_substeps as Real;
+            let omega_target = 2.0 * settings.stability_margin / h;
+            let stiffness = self.diagonal_stiffness();
+            // Local frequency ω_i² ≈ factor · k_ii / m_i; the factor starts at Gershgorin's 2 and
+            // grows until the power iteration confirms the target (a few rounds at most).
+            let mut factor = 2.0;
+            for _ in 0..4 {
+                if self.omega_max <= omega_target {
+                    break;
+                }
+                for ((mi, m0), k) in self.inertial_mass.iter_mut().zip(&self.mass).zip(&stiffness) {
+                    *mi = m0.max(factor * k / (omega_target * omega_target));
+                }
+                self.update_inverse_masses();
+                self.omega_max = crate::stability::max_angular_frequency(self);
+                factor *= (self.omega_max / omega_target).powi(2).max(1.1);
+            }
+        }
+    }
+
+    fn update_inverse_masses(&mut self) {
+        for i in 0..self.x.len() {
+            self.inv_mass[i] = if self.fixed[i] {
+                0.0
+            } else {
+                1.0 / self.inertial_mass[i]
+            };
+        }
+    }
+
+    /// An estimate (N/m) of each particle's diagonal stiffness at rest: the elastic terms of
+    /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms.
+    fn diagonal_stiffness(&self) -> Vec<Real> {
+        let pwave = self.model.p_wave_modulus();
+        let mut k = vec![0.0; self.x.len()];
+        for (i, vi) in self.particle_volume.iter().enumerate() {
+            let mut dsum = Vec3::zeros();
+            for e in self.nbr.range(i) {
+                let j = self.nbr.index[e] as usize;
+                let d = self.nbr.gradient[e];
+                let hg = self.model.hourglass * vi * self.nbr.hourglass_weight[e];
+                k[j] += pwave * vi * d.norm_squared() + hg;
+                k[i] += hg;
+                dsum += d;
+            }
+            k[i] += pwave * vi * dsum.norm_squared();
+        }
+        k
+    }
+
+    /// Mark particle `i` fixed: zero inverse mass and velocity.
+    pub(crate) fn fix(&mut self, i: usize) {
+        self.fixed[i] = true;
+        self.inv_mass[i] = 0.0;
+        self.v[i] = Vec3::zeros();
+    }
+}
+
+/// Sum of the signed volumes (m³) of `tets` at positions `x`.
+pub(crate) fn volume_of(x: &[Vec3], tets: &[[u32; 4]]) -> Real {
+    tets.iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|k| k as usize);
+            tet_volume(&x[a], &x[b], &x[c], &x[d])
+        })
+        .sum()
 }

@@ -34,6 +34,7 @@ pub mod math;
 pub mod mesh;
 pub mod neighbours;
 pub mod settings;
+pub mod stability;
 pub mod state;
 pub mod world;
 

@@ -31,6 +31,12 @@ pub struct Settings {
     pub max_substeps: u32,
     /// Fraction (0, 1] of the explicit stability limit `2/ω_max` that a substep may use.
     pub stability_margin: Real,
+    /// Selective mass scaling: particles whose own stable time step is shorter than
+    /// `dt / min_substeps` (tiny boundary particles of graded meshes) get extra inertial mass so
+    /// that the step needs no extra substeps. Gravity still acts on the physical mass, so static
+    /// equilibria and contact forces at rest are unchanged; the added mass is reported by
+    /// [`Body::added_mass`](crate::Body::added_mass).
+    pub mass_scaling: bool,
     /// Mass-proportional (ambient) damping rate α (1/s): each substep scales particle velocities
     /// by `1/(1 + α·dt)`. Models the viscous surroundings of an organ; damps rigid motion too.
     pub damping_mass: Real,
@@ -63,6 +69,7 @@ impl Default for Settings {
             min_substeps: 1,
             max_substeps: 64,
             stability_margin: 0.9,
+            mass_scaling: true,
             damping_mass: 2.0,
             damping_stiffness: 0.0,
             hourglass_stiffness: 0.05,

@@ -1,1 +1,217 @@
-//! TODO
+//! Save and restore a world's dynamic state in an explicit, versioned byte format.
+//!
+//! Layout (all little-endian):
+//!
+//! | field | type |
+//! |---|---|
+//! | magic `TSIMSTAT` | 8 bytes |
+//! | format version ([`STATE_VERSION`]) | u32 |
+//! | body count, tool count | u32, u32 |
+//! | time (s) | f64 |
+//! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
+//! | per tool: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
+//! | FNV-1a 64 checksum of everything before it | u64 |
+//!
+//! The scene itself (meshes, materials, fixed particles, settings) is not part of the state: a
+//! state restores into a world built the same way. Restoring then stepping reproduces the
+//! original run bit for bit.
+
+use crate::collision::tool::{Pose, Wrench};
+use crate::error::Error;
+use crate::math::{Quat, Real, Vec3};
+use crate::world::World;
+
+/// Version of the byte format written by [`World::save_state`].
+pub const STATE_VERSION: u32 = 1;
+
+const MAGIC: &[u8; 8] = b"TSIMSTAT";
+const HEADER: usize = 8 + 4 + 4 + 4 + 8;
+const TOOL_REALS: usize = 7 + 7 + 3 + 3 + 3 + 1;
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+struct Writer<'a>(&'a mut Vec<u8>);
+
+impl Writer<'_> {
+    fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: Real) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn vec3(&mut self, v: &Vec3) {
+        v.iter().for_each(|c| self.f64(*c));
+    }
+    fn quat(&mut self, q: &Quat) {
+        [q.w, q.i, q.j, q.k].iter().for_each(|c| self.f64(*c));
+    }
+    fn pose(&mut self, p: &Pose) {
+        self.vec3(&p.position);
+        self.quat(&p.orientation);
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn u32(&mut self) -> u32 {
+        let v = u32::from_le_bytes(self.bytes[self.at..self.at + 4].try_into().unwrap_or([0; 4]));
+        self.at += 4;
+        v
+    }
+    fn f64(&mut self) -> Real {
+        let v = f64::from_le_bytes(self.bytes[self.at..self.at + 8].try_into().unwrap_or([0; 8]));
+        self.at += 8;
+        v
+    }
+    fn vec3(&mut self) -> Vec3 {
+        Vec3::new(self.f64(), self.f64(), self.f64())
+    }
+    fn quat(&mut self) -> Quat {
+        let (w, i, j, k) = (self.f64(), self.f64(), self.f64(), self.f64());
+        Quat::new_unchecked(nalgebra::Quaternion::new(w, i, j, k))
+    }
+    fn pose(&mut self) -> Pose {
+        Pose {
+            position: self.vec3(),
+            orientation: self.quat(),
+        }
+    }
+}
+
+impl World {
+    /// Size in bytes of the state [`World::save_state`] writes.
+    pub fn state_size(&self) -> usize {
+        let particles: usize = self.bodies.iter().map(|b| b.particle_count()).sum();
+        HEADER
+            + self.bodies.len() * 4
+            + particles * 10 * 8
+            + self.tools.len() * (TOOL_REALS * 8 + 4)
+            + 8
+    }
+
+    /// Append the dynamic state (time, particle positions, velocities and rotations, tool poses,
+    /// velocities and wrenches) to `out`, in the format of [`crate::state`].
+    pub fn save_state(&self, out: &mut Vec<u8>) {
+        let start = out.len();
+        out.reserve(self.state_size());
+        let mut w = Writer(out);
+        w.0.extend_from_slice(MAGIC);
+        w.u32(STATE_VERSION);
+        w.u32(self.bodies.len() as u32);
+        w.u32(self.tools.len() as u32);
+        w.f64(self.time);
+        for b in &self.bodies {
+            w.u32(b.particle_count() as u32);
+            b.x.iter().for_each(|p| w.vec3(p));
+            b.v.iter().for_each(|v| w.vec3(v));
+            b.rotation.iter().for_each(|q| w.quat(q));
+        }
+        for t in &self.tools {
+            w.pose(&t.pose);
+            w.pose(&t.target);
+            w.vec3(&t.linear_velocity);
+            w.vec3(&t.wrench.force);
+            w.vec3(&t.wrench.torque);
+            w.u32(t.wrench.contact_count);
+            w.f64(t.wrench.max_penetration);
+        }
+        let sum = fnv1a(&out[start..]);
+        out.extend_from_slice(&sum.to_le_bytes());
+    }
+
+    /// Restore a state written by [`World::save_state`] of a world built the same way. On any
+    /// mismatch (magic, version, counts, size, checksum, non-finite values) the world is left
+    /// unchanged and [`Error::BadState`] says why.
+    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), Error> {
+        let bad = |m: &str| Err(Error::BadState(m.to_string()));
+        if bytes.len() < HEADER + 8 || &bytes[..8] != MAGIC {
+            return bad("not a tissuesim state (magic bytes missing)");
+        }
+        let mut r = Reader { bytes, at: 8 };
+        let version = r.u32();
+        if version != STATE_VERSION {
+            return Err(Error::BadState(format!(
+                "state format version {version}, this library reads {STATE_VERSION}"
+            )));
+        }
+        if r.u32() as usize != self.bodies.len() || r.u32() as usize != self.tools.len() {
+            return bad("body or tool count differs from this world");
+        }
+        if bytes.len() != self.state_size() {
+            return Err(Error::BadState(format!(
+                "state is {} bytes, this world's is {}",
+                bytes.len(),
+                self.state_size()
+            )));
+        }
+        let body_len = bytes.len() - 8;
+        let sum = u64::from_le_bytes(bytes[body_len..].try_into().unwrap_or([0; 8]));
+        if fnv1a(&bytes[..body_len]) != sum {
+            return bad("checksum mismatch (corrupted state)");
+        }
+        // Check particle counts and finiteness before changing anything.
+        let mut check = Reader { bytes, at: HEADER };
+        for b in &self.bodies {
+            if check.u32() as usize != b.particle_count() {
+                return bad("particle count differs from this world");
+            }
+            check.at += b.particle_count() * 10 * 8;
+        }
+        let mut scan = Reader {
+            bytes,
+            at: HEADER - 8,
+        };
+        if !scan.f64().is_finite() {
+            return bad("non-finite time");
+        }
+        for b in &self.bodies {
+            scan.at += 4;
+            if (0..b.particle_count() * 10).any(|_| !scan.f64().is_finite()) {
+                return bad("non-finite particle state");
+            }
+        }
+        for _ in &self.tools {
+            let head_finite = (0..TOOL_REALS - 1).all(|_| scan.f64().is_finite());
+            scan.at += 4;
+            if !head_finite || !scan.f64().is_finite() {
+                return bad("non-finite tool state");
+            }
+        }
+        // Everything checked: apply.
+        r.at = HEADER - 8;
+        self.time = r.f64();
+        for b in &mut self.bodies {
+            r.u32();
+            b.x.iter_mut().for_each(|p| *p = r.vec3());
+            b.v.iter_mut().for_each(|v| *v = r.vec3());
+            b.rotation.iter_mut().for_each(|q| *q = r.quat());
+        }
+        for t in &mut self.tools {
+            t.pose = r.pose();
+            t.target = r.pose();
+            t.linear_velocity = r.vec3();
+            let force = r.vec3();
+            let torque = r.vec3();
+            let contact_count = r.u32();
+            let max_penetration = r.f64();
+            t.wrench = Wrench {
+                force,
+                torque,
+                contact_count,
+                max_penetration,
+            };
+        }
+        Ok(())
+    }
+}

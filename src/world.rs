@@ -1,11 +1,32 @@
 //! The scene: bodies, tools and settings; [`World::step`] runs Algorithm 1 of the paper.
+//!
+//! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
+//! limit of the stiffest body, at least `Settings::min_substeps`). Each substep:
+//! 1. forces: gravity, point-based elasticity with hourglass control and pair damping;
+//! 2. symplectic prediction `v ← v/(1 + α h) + h f/m`, `p = x + h v` (fixed particles stay);
+//! 3. `Settings::iterations` Gauss–Seidel passes over the XPBD tetrahedron volume constraints,
+//!    organ–organ contacts (with friction) and tool contacts (with friction), in that order;
+//! 4. `v = (p - x)/h`, `x = p`.
+//!
+//! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
+//! substeps (linear position, slerp orientation). After the step every position and velocity is
+//! checked: a NaN or Inf rolls the world back to its state before the step and the step returns
+//! [`Error::Diverged`] (counted by [`World::diverged_steps`]).
 
-use crate::body::{Body, BodyOptions};
-use crate::collision::tool::{Pose, Tool, ToolOptions, ToolShape};
+use crate::body::{Body, BodyOptions, ROTATION_ITERATIONS};
+use crate::collision::hash_grid::HashGrid;
+use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape, Wrench};
+use crate::constraints::contact::{
+    project_particle_particle, project_point_sphere, project_point_surface, ContactProjection,
+};
+use crate::constraints::friction::friction_correction;
+use crate::constraints::volume::project_volume_tet;
+use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::error::Error;
-use crate::math::{Real, Vec3};
+use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
-use crate::settings::Settings;
+use crate::settings::{ContactMode, Settings};
+use parry3d_f64::math::Point;
 
 /// Identifies a body inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -24,12 +45,22 @@ pub struct StepReport {
     pub substeps_clamped: bool,
 }
 
+/// Friction between two bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PairFriction {
+    bodies: (u32, u32),
+    mu_s: Real,
+    mu_k: Real,
+}
+
 /// A simulated scene.
 pub struct World {
-    settings: Settings,
-    bodies: Vec<Body>,
-    tools: Vec<Tool>,
-    time: Real,
+    pub(crate) settings: Settings,
+    pub(crate) bodies: Vec<Body>,
+    pub(crate) tools: Vec<Tool>,
+    pair_friction: Vec<PairFriction>,
+    grid: HashGrid,
+    pub(crate) time: Real,
     diverged_steps: u64,
 }
 
@@ -41,6 +72,8 @@ impl World {
             settings,
             bodies: Vec::new(),
             tools: Vec::new(),
+            pair_friction: Vec::new(),
+            grid: HashGrid::default(),
             time: 0.0,
             diverged_steps: 0,
         })
@@ -51,8 +84,21 @@ impl World {
     }
     /// Replace the settings (validated; the world is unchanged on error).
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), Error> {
-        let _ = settings;
-        todo!()
+        settings.validate()?;
+        let s = &self.settings;
+        let bodies_affected = settings.hourglass_stiffness != s.hourglass_stiffness
+            || settings.damping_stiffness != s.damping_stiffness
+            || settings.mass_scaling != s.mass_scaling
+            || settings.dt != s.dt
+            || settings.min_substeps != s.min_substeps
+            || settings.stability_margin != s.stability_margin;
+        if bodies_affected {
+            for b in &mut self.bodies {
+                b.configure(&settings);
+            }
+        }
+        self.settings = settings;
+        Ok(())
     }
     /// Simulated time (s) since the world was created.
     pub fn time(&self) -> Real {
@@ -64,8 +110,11 @@ impl World {
     }
     /// Add a deformable body built from `mesh` (node positions in m).
     pub fn add_body(&mut self, mesh: &TetMesh, options: &BodyOptions) -> Result<BodyId, Error> {
-        let _ = (mesh, options, &mut self.bodies);
-        todo!()
+        let body = Body::new(mesh, options, &self.settings)?;
+        self.bodies.push(body);
+        self.grid
+            .reserve(self.bodies.iter().map(|b| b.particle_count()).sum());
+        Ok(BodyId(self.bodies.len() as u32 - 1))
     }
     /// Number of bodies.
     pub fn body_count(&self) -> usize {
@@ -77,25 +126,59 @@ impl World {
             .get(id.0 as usize)
             .ok_or(Error::UnknownBody(id.0))
     }
-    /// Fix the particles with the given indices (they keep their current position).
+    fn body_mut(&mut self, id: BodyId) -> Result<&mut Body, Error> {
+        self.bodies
+            .get_mut(id.0 as usize)
+            .ok_or(Error::UnknownBody(id.0))
+    }
+    /// Fix the particles with the given indices (they keep their current position). Nothing is
+    /// fixed if any index is out of range.
     pub fn fix_particles(&mut self, id: BodyId, indices: &[u32]) -> Result<(), Error> {
-        let _ = (id, indices);
-        todo!()
+        let body = self.body_mut(id)?;
+        let n = body.particle_count();
+        if let Some(&k) = indices.iter().find(|&&k| k as usize >= n) {
+            return Err(Error::InvalidArgument(format!(
+                "particle index {k} out of range (body has {n} particles)"
+            )));
+        }
+        for &k in indices {
+            body.fix(k as usize);
+        }
+        Ok(())
     }
-    /// Fix every particle whose current position lies in the box `[min, max]` (m); returns how many.
+    /// Fix every particle whose current position lies in the box `[min, max]` (m); returns how
+    /// many particles the box holds.
     pub fn fix_box(&mut self, id: BodyId, min: Vec3, max: Vec3) -> Result<usize, Error> {
-        let _ = (id, min, max);
-        todo!()
+        if !is_finite_vec(&min) || !is_finite_vec(&max) {
+            return Err(Error::NonFinite("fixed box".into()));
+        }
+        let body = self.body_mut(id)?;
+        let inside: Vec<usize> = (0..body.particle_count())
+            .filter(|&i| {
+                let p = body.x[i];
+                (0..3).all(|a| p[a] >= min[a] && p[a] <= max[a])
+            })
+            .collect();
+        for &i in &inside {
+            body.fix(i);
+        }
+        Ok(inside.len())
     }
-    /// Add a kinematic tool.
+    /// Add a kinematic tool. Its surface samples (for the sampled contact mode) are spaced by
+    /// `options.sample_spacing`, or by the particle radius of the first body (5 mm without one).
     pub fn add_tool(
         &mut self,
         shape: ToolShape,
         pose: Pose,
         options: &ToolOptions,
     ) -> Result<ToolId, Error> {
-        let _ = (shape, pose, options, &mut self.tools);
-        todo!()
+        let spacing = self
+            .bodies
+            .first()
+            .map(|b| b.particle_radius())
+            .unwrap_or(0.005);
+        self.tools.push(Tool::new(shape, pose, options, spacing)?);
+        Ok(ToolId(self.tools.len() as u32 - 1))
     }
     /// Number of tools.
     pub fn tool_count(&self) -> usize {
@@ -106,11 +189,38 @@ impl World {
         self.tools.get(id.0 as usize).ok_or(Error::UnknownTool(id.0))
     }
     /// Set the pose a tool reaches at the end of the next step (interpolated across substeps).
+    /// A NaN/Inf or non-unit pose is rejected and nothing changes.
     pub fn set_tool_pose(&mut self, id: ToolId, pose: Pose) -> Result<(), Error> {
-        let _ = (id, pose);
-        todo!()
+        if !pose.is_valid() {
+            return Err(Error::NonFinite(
+                "tool pose must be finite with a unit quaternion".into(),
+            ));
+        }
+        let tool = self
+            .tools
+            .get_mut(id.0 as usize)
+            .ok_or(Error::UnknownTool(id.0))?;
+        tool.target = pose;
+        Ok(())
     }
-    /// Friction coefficients (μ_s, μ_k) between two bodies (organ–organ contact).
+    /// Friction coefficients (μ_s, μ_k) of a tool.
+    pub fn set_tool_friction(
+        &mut self,
+        id: ToolId,
+        friction_static: Real,
+        friction_kinetic: Real,
+    ) -> Result<(), Error> {
+        check_friction(friction_static, friction_kinetic)?;
+        let tool = self
+            .tools
+            .get_mut(id.0 as usize)
+            .ok_or(Error::UnknownTool(id.0))?;
+        tool.options.friction_static = friction_static;
+        tool.options.friction_kinetic = friction_kinetic;
+        Ok(())
+    }
+    /// Friction coefficients (μ_s, μ_k) between two bodies (organ–organ contact; frictionless
+    /// unless set).
     pub fn set_body_pair_friction(
         &mut self,
         a: BodyId,
@@ -118,26 +228,310 @@ impl World {
         friction_static: Real,
         friction_kinetic: Real,
     ) -> Result<(), Error> {
-        let _ = (a, b, friction_static, friction_kinetic);
-        todo!()
+        self.body(a)?;
+        self.body(b)?;
+        check_friction(friction_static, friction_kinetic)?;
+        let key = (a.0.min(b.0), a.0.max(b.0));
+        self.pair_friction.retain(|f| f.bodies != key);
+        self.pair_friction.push(PairFriction {
+            bodies: key,
+            mu_s: friction_static,
+            mu_k: friction_kinetic,
+        });
+        Ok(())
     }
-    /// Advance the world by `settings.dt`.
+
+    /// Substeps a step needs for stability, and whether `max_substeps` clamped that number.
+    pub fn substeps_needed(&self) -> (u32, bool) {
+        let s = &self.settings;
+        let mut h_max = Real::INFINITY;
+        for b in &self.bodies {
+            let w = b.omega_max;
+            if w > 0.0 {
+                // Symplectic Euler with stiffness-proportional damping ξ = βω/2.
+                let xi = 0.5 * s.damping_stiffness * w;
+                h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
+            }
+        }
+        let needed = (s.dt / (s.stability_margin * h_max)).ceil();
+        let needed = if needed.is_finite() { needed as u32 } else { 1 };
+        let n = needed.max(s.min_substeps);
+        if n > s.max_substeps {
+            (s.max_substeps, true)
+        } else {
+            (n, false)
+        }
+    }
+
+    /// Advance the world by `settings.dt`. On NaN/Inf the world is rolled back and
+    /// [`Error::Diverged`] returned.
     pub fn step(&mut self) -> Result<StepReport, Error> {
-        todo!()
+        let (n, clamped) = self.substeps_needed();
+        for b in &mut self.bodies {
+            b.saved_x.copy_from_slice(&b.x);
+            b.saved_v.copy_from_slice(&b.v);
+            b.saved_rotation.copy_from_slice(&b.rotation);
+        }
+        let h = self.settings.dt / n as Real;
+        for t in &mut self.tools {
+            t.acc_impulse = Vec3::zeros();
+            t.acc_moment = Vec3::zeros();
+            t.acc_penetration = 0.0;
+        }
+        for k in 1..=n {
+            self.substep(h, k, n);
+        }
+        if let Some((b, i)) = self.first_non_finite() {
+            for body in &mut self.bodies {
+                body.x.copy_from_slice(&body.saved_x);
+                body.v.copy_from_slice(&body.saved_v);
+                body.rotation.copy_from_slice(&body.saved_rotation);
+            }
+            self.diverged_steps += 1;
+            return Err(Error::Diverged(format!(
+                "body {b} particle {i} became non-finite at t = {} s; reduce dt or stiffness",
+                self.time
+            )));
+        }
+        let dt = self.settings.dt;
+        for t in &mut self.tools {
+            let scale = -1.0 / (h * h * n as Real);
+            t.wrench = Wrench {
+                force: t.acc_impulse * scale,
+                torque: t.acc_moment * scale,
+                contact_count: t.acc_contacts,
+                max_penetration: t.acc_penetration,
+            };
+            t.linear_velocity = (t.target.position - t.pose.position) / dt;
+            t.pose = t.target;
+        }
+        self.time += dt;
+        Ok(StepReport {
+            substeps: n,
+            substeps_clamped: clamped,
+        })
     }
-    /// Size in bytes of the state [`World::save_state`] writes.
-    pub fn state_size(&self) -> usize {
-        todo!()
+
+    fn first_non_finite(&self) -> Option<(usize, usize)> {
+        self.bodies.iter().enumerate().find_map(|(b, body)| {
+            body.x
+                .iter()
+                .zip(&body.v)
+                .position(|(x, v)| !is_finite_vec(x) || !is_finite_vec(v))
+                .map(|i| (b, i))
+        })
     }
-    /// Append the dynamic state (time, positions, velocities, tool poses, ...) to `out`,
-    /// in the versioned format of [`crate::state`].
-    pub fn save_state(&self, out: &mut Vec<u8>) {
-        let _ = out;
-        todo!()
+
+    /// Substep `k` of `n` (1-based) of length `h` (s).
+    fn substep(&mut self, h: Real, k: u32, n: u32) {
+        let s = &self.settings;
+        let gravity = s.gravity;
+        let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
+        for body in &mut self.bodies {
+            predict(body, gravity, h, alpha_damp);
+        }
+        let organ_contact = self.bodies.len() > 1 || s.self_contact;
+        if organ_contact {
+            let cell = 2.0
+                * self
+                    .bodies
+                    .iter()
+                    .map(|b| b.particle_radius)
+                    .fold(0.0, Real::max);
+            self.grid
+                .build(self.bodies.iter().map(|b| b.p.as_slice()), cell);
+        }
+        for t in &mut self.tools {
+            t.acc_contacts = 0;
+        }
+        let s_prev = (k - 1) as Real / n as Real;
+        let s_cur = k as Real / n as Real;
+        for it in 0..self.settings.iterations {
+            if self.settings.volume_constraints {
+                let compliance = self.settings.volume_compliance;
+                for body in &mut self.bodies {
+                    project_volumes(body, compliance / (h * h));
+                }
+            }
+            if organ_contact {
+                self.project_organ_contacts();
+            }
+            let mode = self.settings.contact_mode;
+            for tool in &mut self.tools {
+                let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
+                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                for body in &mut self.bodies {
+                    project_tool_contacts(tool, body, &prev, &cur, mode, it == 0);
+                }
+            }
+        }
+        for body in &mut self.bodies {
+            let inv_h = 1.0 / h;
+            for i in 0..body.x.len() {
+                body.v[i] = (body.p[i] - body.x[i]) * inv_h;
+                body.x[i] = body.p[i];
+            }
+        }
     }
-    /// Restore a state written by [`World::save_state`] of a world with the same scene.
-    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), Error> {
-        let _ = bytes;
-        todo!()
+
+    fn project_organ_contacts(&mut self) {
+        let self_contact = self.settings.self_contact;
+        let nb = self.bodies.len();
+        for a in 0..nb {
+            for i in 0..self.bodies[a].particle_count() {
+                let pi = self.bodies[a].p[i];
+                let grid = &self.grid;
+                let bodies = &mut self.bodies;
+                let friction = &self.pair_friction;
+                grid.for_each_near(&pi, |[b, j]| {
+                    let (b, j) = (b as usize, j as usize);
+                    if (b, j) <= (a, i) || (a == b && !self_contact) {
+                        return;
+                    }
+                    let ra = bodies[a].particle_radius;
+                    let rb = bodies[b].particle_radius;
+                    if a == b {
+                        // Particles close at rest belong to the same piece of tissue.
+                        let rest_d = (bodies[a].rest[i] - bodies[a].rest[j]).norm();
+                        if rest_d < 2.0 * (ra + rb) {
+                            return;
+                        }
+                    }
+                    let (wa, wb) = (bodies[a].inv_mass[i], bodies[b].inv_mass[j]);
+                    let (mut pa, mut pb) = (bodies[a].p[i], bodies[b].p[j]);
+                    let Some(c) = project_particle_particle(&mut pa, &mut pb, wa, wb, ra + rb)
+                    else {
+                        return;
+                    };
+                    let key = (a.min(b) as u32, a.max(b) as u32);
+                    if let Some(f) = friction.iter().find(|f| f.bodies == key) {
+                        let rel = (pa - bodies[a].x[i]) - (pb - bodies[b].x[j]);
+                        let dfr = friction_correction(&rel, &c.normal, c.depth, f.mu_s, f.mu_k);
+                        let wsum = wa + wb;
+                        pa += dfr * (wa / wsum);
+                        pb -= dfr * (wb / wsum);
+                    }
+                    bodies[a].p[i] = pa;
+                    bodies[b].p[j] = pb;
+                });
+            }
+        }
+    }
+}
+
+/// Forces, then the symplectic prediction of one body for a substep `h` (s).
+fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real) {
+    for i in 0..body.x.len() {
+        body.force[i] = gravity * body.mass[i];
+    }
+    let input = ForceInputs {
+        nbr: &body.nbr,
+        volume: &body.particle_volume,
+        x: &body.x,
+        v: &body.v,
+    };
+    accumulate_forces(
+        &body.model,
+        &input,
+        &mut body.rotation,
+        ROTATION_ITERATIONS,
+        &mut body.force,
+    );
+    for i in 0..body.x.len() {
+        let w = body.inv_mass[i];
+        if body.fixed[i] {
+            body.v[i] = Vec3::zeros();
+            body.p[i] = body.x[i];
+        } else {
+            body.v[i] = body.v[i] * damping_factor + body.force[i] * (h * w);
+            body.p[i] = body.x[i] + body.v[i] * h;
+        }
+    }
+    body.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
+}
+
+/// One Gauss–Seidel pass over a body's tetrahedron volume constraints; `compliance_per_h2` is
+/// the volume compliance (1/Pa) divided by h² (s²).
+fn project_volumes(body: &mut Body, compliance_per_h2: Real) {
+    for t in 0..body.tets.len() {
+        let v0 = body.tet_rest_volume[t];
+        project_volume_tet(
+            &mut body.p,
+            &body.inv_mass,
+            body.tets[t],
+            v0,
+            compliance_per_h2 * v0,
+            &mut body.tet_lambda[t],
+        );
+    }
+}
+
+/// Project the contacts between `tool` (moving from `prev` to `cur` over this substep) and the
+/// particles of `body`, with friction, and accumulate the tool's impulse and moment.
+fn project_tool_contacts(
+    tool: &mut Tool,
+    body: &mut Body,
+    prev: &Pose,
+    cur: &Pose,
+    mode: ContactMode,
+    count: bool,
+) {
+    let iso = cur.isometry();
+    // Maps a point attached to the tool at `cur` to where it was at `prev`.
+    let back = prev.isometry() * iso.inverse();
+    let centre = cur.position;
+    let r = body.particle_radius;
+    let reach = tool.bounding_radius + r;
+    let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
+    for i in 0..body.x.len() {
+        if body.inv_mass[i] == 0.0 {
+            continue;
+        }
+        let before = body.p[i];
+        if (before - centre).norm_squared() > reach * reach {
+            continue;
+        }
+        let mut p = before;
+        // The last contact point on the tool surface, where the impulse acts on the tool.
+        let mut touched: Option<Vec3> = None;
+        let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
+            let tool_motion = contact - back.transform_point(&Point::from(contact)).coords;
+            let rel = (*p - body.x[i]) - tool_motion;
+            *p += friction_correction(&rel, &c.normal, c.depth, mu_s, mu_k);
+            tool.acc_penetration = tool.acc_penetration.max(c.depth);
+            touched = Some(contact);
+        };
+        match mode {
+            ContactMode::ExactShape => {
+                let proj = tool.shape.project_point(&iso, &Point::from(p), false);
+                let fallback = (p - centre)
+                    .try_normalize(1e-12)
+                    .unwrap_or_else(Vec3::y);
+                let surface = proj.point.coords;
+                if let Some(c) = project_point_surface(&mut p, &surface, proj.is_inside, r, &fallback)
+                {
+                    apply(&mut p, c, surface, tool);
+                }
+            }
+            ContactMode::SampledPoints => {
+                let rs = tool.sample_radius;
+                for s in 0..tool.samples.len() {
+                    let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
+                    if let Some(c) = project_point_sphere(&mut p, &sw, r + rs) {
+                        let contact = sw + c.normal * rs;
+                        apply(&mut p, c, contact, tool);
+                    }
+                }
+            }
+        }
+        if let Some(contact) = touched {
+            let impulse = (p - before) * body.inertial_mass[i];
+            tool.acc_impulse += impulse;
+            tool.acc_moment += (contact - centre).cross(&impulse);
+            if count {
+                tool.acc_contacts += 1;
+            }
+            body.p[i] = p;
+        }
     }
 }

@@ -1,6 +1,9 @@
 //! Kinematic rigid instruments: their shape (a parry shape), pose, friction and contact wrench.
 
-use crate::math::{Quat, Real, Vec3};
+use crate::error::Error;
+use crate::math::{is_finite_vec, Quat, Real, Vec3};
+use parry3d_f64::math::{Isometry, Point, Translation};
+use parry3d_f64::shape::{SharedShape, TriMeshFlags};
 
 /// The shape of a tool, in its own frame (m). Built into a parry shape when the tool is added.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,6 +63,51 @@ impl Pose {
             orientation: Quat::identity(),
         }
     }
+
+    /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised on use.
+    /// Rejects NaN/Inf and a (near) zero quaternion.
+    pub fn from_components(position: [Real; 3], quaternion: [Real; 4]) -> Result<Self, Error> {
+        let p = Vec3::from(position);
+        if !is_finite_vec(&p) || quaternion.iter().any(|c| !c.is_finite()) {
+            return Err(Error::NonFinite("tool pose".into()));
+        }
+        let [w, x, y, z] = quaternion;
+        let q = nalgebra::Quaternion::new(w, x, y, z);
+        let norm = q.norm();
+        if norm < 1e-12 {
+            return Err(Error::InvalidArgument(
+                "tool orientation: zero quaternion".into(),
+            ));
+        }
+        Ok(Pose {
+            position: p,
+            orientation: Quat::new_unchecked(q / norm),
+        })
+    }
+
+    /// Interpolate between `a` (s = 0) and `b` (s = 1): linear in position, slerp in
+    /// orientation.
+    pub fn interpolate(a: &Pose, b: &Pose, s: Real) -> Pose {
+        Pose {
+            position: a.position.lerp(&b.position, s),
+            orientation: a
+                .orientation
+                .try_slerp(&b.orientation, s, 1e-12)
+                .unwrap_or(b.orientation),
+        }
+    }
+
+    /// The pose as a parry isometry.
+    pub(crate) fn isometry(&self) -> Isometry<Real> {
+        Isometry::from_parts(Translation::from(self.position), self.orientation)
+    }
+
+    /// True when both parts are finite and the quaternion has unit norm (within 1e-6).
+    pub fn is_valid(&self) -> bool {
+        is_finite_vec(&self.position)
+            && self.orientation.coords.iter().all(|c| c.is_finite())
+            && (self.orientation.coords.norm() - 1.0).abs() < 1e-6
+    }
 }
 
 /// Options of a tool.
@@ -98,19 +146,193 @@ pub struct Wrench {
 }
 
 /// A kinematic tool inside a world.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct Tool {
+    pub(crate) description: ToolShape,
+    pub(crate) shape: SharedShape,
+    pub(crate) options: ToolOptions,
+    /// Pose at the end of the last step.
     pub(crate) pose: Pose,
+    /// Pose to reach at the end of the next step.
+    pub(crate) target: Pose,
+    /// Radius (m) of a sphere about the tool origin that contains the shape.
+    pub(crate) bounding_radius: Real,
+    /// Surface samples in the local frame (m), moved inwards by `sample_radius`.
+    pub(crate) samples: Vec<Vec3>,
+    /// Radius of each surface sample sphere (m).
+    pub(crate) sample_radius: Real,
+    /// Linear velocity of the origin over the last step (m/s).
+    pub(crate) linear_velocity: Vec3,
     pub(crate) wrench: Wrench,
+    /// Accumulators of the step in progress: Σ m Δx (kg·m), Σ (q - o) × m Δx (kg·m²).
+    pub(crate) acc_impulse: Vec3,
+    pub(crate) acc_moment: Vec3,
+    pub(crate) acc_contacts: u32,
+    pub(crate) acc_penetration: Real,
+}
+
+impl std::fmt::Debug for Tool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Tool")
+            .field("shape", &self.description)
+            .field("pose", &self.pose)
+            .field("wrench", &self.wrench)
+            .finish()
+    }
 }
 
 impl Tool {
+    /// Build a tool; `default_spacing` (m) is used for surface samples when the options give
+    /// none.
+    pub(crate) fn new(
+        description: ToolShape,
+        pose: Pose,
+        options: &ToolOptions,
+        default_spacing: Real,
+    ) -> Result<Tool, Error> {
+        if !pose.is_valid() {
+            return Err(Error::NonFinite("tool pose".into()));
+        }
+        check_friction(options.friction_static, options.friction_kinetic)?;
+        let positive = |name: &str, v: Real| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::InvalidArgument(format!(
+                    "tool {name} must be finite and > 0 m, got {v}"
+                )))
+            }
+        };
+        let to_points = |v: &[Vec3]| -> Result<Vec<Point<Real>>, Error> {
+            if v.iter().any(|p| !is_finite_vec(p)) {
+                return Err(Error::NonFinite("tool vertices".into()));
+            }
+            Ok(v.iter().map(|p| Point::from(*p)).collect())
+        };
+        let shape = match &description {
+            ToolShape::Sphere { radius } => {
+                positive("radius", *radius)?;
+                SharedShape::ball(*radius)
+            }
+            ToolShape::Capsule {
+                half_height,
+                radius,
+            } => {
+                positive("radius", *radius)?;
+                positive("half height", *half_height)?;
+                SharedShape::capsule_y(*half_height, *radius)
+            }
+            ToolShape::Cylinder {
+                half_height,
+                radius,
+            } => {
+                positive("radius", *radius)?;
+                positive("half height", *half_height)?;
+                SharedShape::cylinder(*half_height, *radius)
+            }
+            ToolShape::Cuboid { half_extents } => {
+                for k in 0..3 {
+                    positive("half extent", half_extents[k])?;
+                }
+                SharedShape::cuboid(half_extents.x, half_extents.y, half_extents.z)
+            }
+            ToolShape::ConvexHull { points } => SharedShape::convex_hull(&to_points(points)?)
+                .ok_or_else(|| {
+                    Error::InvalidArgument("convex hull of the tool points is degenerate".into())
+                })?,
+            ToolShape::TriMesh {
+                vertices,
+                triangles,
+            } => {
+                if triangles
+                    .iter()
+                    .any(|t| t.iter().any(|&k| k as usize >= vertices.len()))
+                {
+                    return Err(Error::InvalidArgument(
+                        "tool triangle references a vertex out of range".into(),
+                    ));
+                }
+                SharedShape::trimesh_with_flags(
+                    to_points(vertices)?,
+                    triangles.clone(),
+                    TriMeshFlags::ORIENTED
+                        | TriMeshFlags::MERGE_DUPLICATE_VERTICES
+                        | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES,
+                )
+                .map_err(|e| Error::InvalidArgument(format!("tool triangle mesh: {e:?}")))?
+            }
+        };
+        let aabb = shape.compute_local_aabb();
+        let bounding_radius = aabb.center().coords.norm() + aabb.half_extents().norm();
+        let spacing = options.sample_spacing.unwrap_or(default_spacing);
+        positive("sample spacing", spacing)?;
+        let (samples, sample_radius) = crate::collision::sampling::sample_surface(&shape, spacing);
+        Ok(Tool {
+            description,
+            shape,
+            options: options.clone(),
+            pose,
+            target: pose,
+            bounding_radius,
+            samples,
+            sample_radius,
+            linear_velocity: Vec3::zeros(),
+            wrench: Wrench::default(),
+            acc_impulse: Vec3::zeros(),
+            acc_moment: Vec3::zeros(),
+            acc_contacts: 0,
+            acc_penetration: 0.0,
+        })
+    }
+
     /// The pose reached at the end of the last step.
     pub fn pose(&self) -> Pose {
         self.pose
+    }
+    /// The pose the tool will reach at the end of the next step.
+    pub fn target_pose(&self) -> Pose {
+        self.target
+    }
+    /// The shape as given.
+    pub fn shape(&self) -> &ToolShape {
+        &self.description
+    }
+    /// The options (friction, sampling).
+    pub fn options(&self) -> &ToolOptions {
+        &self.options
+    }
+    /// Linear velocity of the tool origin over the last step (m/s).
+    pub fn linear_velocity(&self) -> Vec3 {
+        self.linear_velocity
     }
     /// The contact wrench of the last step (see [`Wrench`]).
     pub fn wrench(&self) -> Wrench {
         self.wrench
     }
+    /// Number of surface samples used in [`ContactMode::SampledPoints`](crate::ContactMode).
+    pub fn sample_count(&self) -> usize {
+        self.samples.len()
+    }
+    /// Signed distance (m) from `point` to the tool surface at `pose`: negative inside.
+    pub fn signed_distance(&self, pose: &Pose, point: &Vec3) -> Real {
+        let proj = self
+            .shape
+            .project_point(&pose.isometry(), &Point::from(*point), false);
+        let d = (proj.point.coords - point).norm();
+        if proj.is_inside {
+            -d
+        } else {
+            d
+        }
+    }
+}
+
+/// Check a pair of friction coefficients: finite, ≥ 0, and μ_k ≤ μ_s.
+pub(crate) fn check_friction(mu_s: Real, mu_k: Real) -> Result<(), Error> {
+    if !(mu_s.is_finite() && mu_k.is_finite() && mu_s >= 0.0 && mu_k >= 0.0 && mu_k <= mu_s) {
+        return Err(Error::InvalidArgument(format!(
+            "friction needs finite 0 <= mu_k <= mu_s, got mu_s {mu_s}, mu_k {mu_k}"
+        )));
+    }
+    Ok(())
 }

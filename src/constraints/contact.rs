@@ -1,0 +1,112 @@
+//! Contact kernels (eq. 9 of the paper): `C = d - r >= 0`, projected on predicted positions.
+
+use crate::math::{Real, Vec3};
+
+/// A contact that was violated and projected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactProjection {
+    /// Unit normal of the contact, pointing from the obstacle towards the particle.
+    pub normal: Vec3,
+    /// Depth of the violation before the projection, `-C` (m, > 0).
+    pub depth: Real,
+}
+
+/// Push a particle at `p` out of a half-space-like obstacle: the particle must be at least `r`
+/// (m) from the obstacle surface, whose closest point is `surface` (m) with the particle inside
+/// the obstacle when `inside`. `fallback_normal` is used when `p` lies on the surface.
+/// Returns the projection when the constraint was violated (and moves `p`).
+#[inline]
+pub fn project_point_surface(
+    p: &mut Vec3,
+    surface: &Vec3,
+    inside: bool,
+    r: Real,
+    fallback_normal: &Vec3,
+) -> Option<ContactProjection> {
+    let offset = *p - surface;
+    let dist = offset.norm();
+    let (signed, normal) = if dist > 1e-12 {
+        let n = offset / dist;
+        if inside {
+            (-dist, -n)
+        } else {
+            (dist, n)
+        }
+    } else {
+        (0.0, *fallback_normal)
+    };
+    let c = signed - r;
+    if c >= 0.0 {
+        return None;
+    }
+    *p -= normal * c;
+    Some(ContactProjection { normal, depth: -c })
+}
+
+/// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m): the
+/// paper's point–point contact with a tool sample.
+#[inline]
+pub fn project_point_sphere(p: &mut Vec3, centre: &Vec3, radius: Real) -> Option<ContactProjection> {
+    let offset = *p - centre;
+    let d2 = offset.norm_squared();
+    if d2 >= radius * radius {
+        return None;
+    }
+    let d = d2.sqrt();
+    let normal = if d > 1e-12 { offset / d } else { Vec3::y() };
+    let depth = radius - d;
+    *p += normal * depth;
+    Some(ContactProjection { normal, depth })
+}
+
+/// Separate two particles (inverse masses `wa`, `wb` in 1/kg) to at least `distance` (m)
+/// apart. Returns the projection (normal from `b` to `a`) when they were too close.
+#[inline]
+pub fn project_particle_particle(
+    pa: &mut Vec3,
+    pb: &mut Vec3,
+    wa: Real,
+    wb: Real,
+    distance: Real,
+) -> Option<ContactProjection> {
+    let offset = *pa - *pb;
+    let d2 = offset.norm_squared();
+    let wsum = wa + wb;
+    if d2 >= distance * distance || wsum <= 0.0 {
+        return None;
+    }
+    let d = d2.sqrt();
+    let normal = if d > 1e-12 { offset / d } else { Vec3::y() };
+    let depth = distance - d;
+    *pa += normal * (depth * wa / wsum);
+    *pb -= normal * (depth * wb / wsum);
+    Some(ContactProjection { normal, depth })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn particle_pair_separation_conserves_momentum_and_reaches_distance() {
+        let (mut a, mut b) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.5, 0.0, 0.0));
+        let (ma, mb) = (2.0, 3.0);
+        let before = a * ma + b * mb;
+        let c = project_particle_particle(&mut a, &mut b, 1.0 / ma, 1.0 / mb, 1.0).unwrap();
+        assert!(((a - b).norm() - 1.0).abs() < 1e-12);
+        assert!((a * ma + b * mb - before).norm() < 1e-12);
+        assert!((c.depth - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn point_outside_beyond_radius_is_untouched_and_inside_is_pushed_out() {
+        let mut p = Vec3::new(0.0, 2.0, 0.0);
+        assert!(project_point_surface(&mut p, &Vec3::new(0.0, 1.0, 0.0), false, 0.5, &Vec3::y())
+            .is_none());
+        let mut q = Vec3::new(0.0, 0.8, 0.0);
+        let c = project_point_surface(&mut q, &Vec3::new(0.0, 1.0, 0.0), true, 0.5, &Vec3::y())
+            .unwrap();
+        assert!((q - Vec3::new(0.0, 1.5, 0.0)).norm() < 1e-12);
+        assert!((c.depth - 0.7).abs() < 1e-12);
+    }
+}
