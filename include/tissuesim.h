@@ -191,6 +191,13 @@ typedef struct ts_settings {
      * Contact between particles of the same body: 0 off, non-zero on.
      */
     uint8_t self_contact;
+    /**
+     * Selective mass scaling: 0 off, non-zero on (the default). Particles whose own stable
+     * time step is shorter than dt / min_substeps get extra inertial mass (not extra weight)
+     * so that the step needs no extra substeps; see ts_body_added_mass. Turn it off for
+     * dynamics comparisons against other solvers.
+     */
+    uint8_t mass_scaling;
 } ts_settings;
 
 /**
@@ -680,6 +687,16 @@ enum ts_status ts_body_rest_volume(const struct ts_world *world, uint32_t body, 
  * `world` is NULL or a live handle; `out` is NULL or writable.
  */
 enum ts_status ts_body_max_displacement(const struct ts_world *world, uint32_t body, double *out);
+
+/**
+ * Inertial mass added to the body by selective mass scaling (kg; 0 when ts_settings.mass_scaling
+ * is off or no particle needed it) into *out_mass.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_mass` is NULL or writable.
+ */
+enum ts_status ts_body_added_mass(const struct ts_world *world, uint32_t body, double *out_mass);
 
 /**
  * Total mass of a body (kg) into *out_mass.

@@ -539,6 +539,8 @@ fn null_parameters() {
             ("max_disp out", ts_body_max_displacement(w, 0, null_mut())),
             ("mass world", ts_body_mass(nc, 0, &mut d)),
             ("mass out", ts_body_mass(w, 0, null_mut())),
+            ("added_mass world", ts_body_added_mass(nc, 0, &mut d)),
+            ("added_mass out", ts_body_added_mass(w, 0, null_mut())),
             (
                 "sphere world",
                 ts_world_add_tool_sphere(nw, 0.01, &p, null(), &mut u),
@@ -705,6 +707,7 @@ fn unknown_ids() {
                 ts_body_rest_volume(w, bad, &mut d),
                 ts_body_max_displacement(w, bad, &mut d),
                 ts_body_mass(w, bad, &mut d),
+                ts_body_added_mass(w, bad, &mut d),
             ]
         };
         for (i, st) in bodies.into_iter().enumerate() {

@@ -729,6 +729,22 @@ pub unsafe extern "C" fn ts_body_max_displacement(
     unsafe { body_value(world, body, out, |b| b.max_displacement()) }
 }
 
+/// Inertial mass added to the body by selective mass scaling (kg; 0 when ts_settings.mass_scaling
+/// is off or no particle needed it) into *out_mass.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_mass` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_added_mass(
+    world: *const ts_world,
+    body: u32,
+    out_mass: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_mass, |b| b.added_mass()) }
+}
+
 /// Total mass of a body (kg) into *out_mass.
 ///
 /// # Safety

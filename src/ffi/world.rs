@@ -51,6 +51,11 @@ pub struct ts_settings {
     pub volume_constraints: u8,
     /// Contact between particles of the same body: 0 off, non-zero on.
     pub self_contact: u8,
+    /// Selective mass scaling: 0 off, non-zero on (the default). Particles whose own stable
+    /// time step is shorter than dt / min_substeps get extra inertial mass (not extra weight)
+    /// so that the step needs no extra substeps; see ts_body_added_mass. Turn it off for
+    /// dynamics comparisons against other solvers.
+    pub mass_scaling: u8,
 }
 
 impl From<&Settings> for ts_settings {
@@ -72,6 +77,7 @@ impl From<&Settings> for ts_settings {
             },
             volume_constraints: s.volume_constraints as u8,
             self_contact: s.self_contact as u8,
+            mass_scaling: s.mass_scaling as u8,
         }
     }
 }
@@ -101,6 +107,9 @@ impl ts_settings {
                 ))
             }
         };
+        // `..Settings::default()` keeps this compiling when the core adds a setting; such a
+        // setting keeps its default until it is added to ts_settings.
+        #[allow(clippy::needless_update)]
         let s = Settings {
             dt: self.dt,
             gravity: Vec3::new(self.gravity[0], self.gravity[1], self.gravity[2]),
@@ -115,6 +124,8 @@ impl ts_settings {
             iterations: self.iterations,
             contact_mode,
             self_contact: self.self_contact != 0,
+            mass_scaling: self.mass_scaling != 0,
+            ..Settings::default()
         };
         s.validate()?;
         Ok(s)

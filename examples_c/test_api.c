@@ -1,0 +1,463 @@
+/*
+ * test_api.c -- calls every function of tissuesim.h and checks statuses and values.
+ * Exits non-zero on any failure; the last line printed is "N passed, M failed".
+ *
+ * TS_STEPS=N sets the number of steps of the stepping checks (default 20).
+ *
+ * Build: cc -Iinclude examples_c/test_api.c -Ltarget/release -ltissuesim -lm -o test_api
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tissuesim.h"
+
+static int passed, failed;
+
+#define CHECK(cond)                                                                                \
+    do {                                                                                           \
+        if (cond) {                                                                                \
+            passed++;                                                                              \
+        } else {                                                                                   \
+            failed++;                                                                              \
+            char m_[512];                                                                          \
+            ts_last_error_message(m_, sizeof m_);                                                  \
+            fprintf(stderr, "%s:%d: CHECK failed: %s (last error: %s)\n", __FILE__, __LINE__,     \
+                    #cond, m_);                                                                    \
+        }                                                                                          \
+    } while (0)
+
+/* `call` returns `expected`. */
+#define CHECK_ST(call, expected) CHECK((call) == (expected))
+#define CHECK_OK(call) CHECK_ST(call, TS_STATUS_OK)
+
+/* The thread's last error message contains `needle`. */
+static int last_error_has(const char *needle) {
+    char msg[1024];
+    ts_last_error_message(msg, sizeof msg);
+    return strstr(msg, needle) != NULL;
+}
+
+/* A lattice of cells^3 cubes of edge h (m), 6 tets each, corner at (OX, 0, 0): away from the
+ * default organ (centred on the origin, about 0.2 m across). */
+#define OX 0.5
+#define CELLS 3
+#define NN ((CELLS + 1) * (CELLS + 1) * (CELLS + 1))
+#define NT (6 * CELLS * CELLS * CELLS)
+static double nodes[3 * NN];
+static uint32_t tets[4 * NT];
+
+static uint32_t node_id(int i, int j, int k) {
+    return (uint32_t)(i + (CELLS + 1) * (j + (CELLS + 1) * k));
+}
+
+static void build_lattice(double h) {
+    for (int k = 0; k <= CELLS; k++)
+        for (int j = 0; j <= CELLS; j++)
+            for (int i = 0; i <= CELLS; i++) {
+                uint32_t id = node_id(i, j, k);
+                nodes[3 * id] = OX + i * h;
+                nodes[3 * id + 1] = j * h;
+                nodes[3 * id + 2] = k * h;
+            }
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                    {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int t = 0;
+    for (int k = 0; k < CELLS; k++)
+        for (int j = 0; j < CELLS; j++)
+            for (int i = 0; i < CELLS; i++)
+                for (int p = 0; p < 6; p++) {
+                    int d[3] = {0, 0, 0};
+                    tets[4 * t] = node_id(i, j, k);
+                    for (int s = 0; s < 3; s++) {
+                        d[perms[p][s]] = 1;
+                        tets[4 * t + s + 1] = node_id(i + d[0], j + d[1], k + d[2]);
+                    }
+                    t++;
+                }
+}
+
+static void write_file(const char *path, const char *text) {
+    FILE *f = fopen(path, "w");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+int main(void) {
+    long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
+    if (steps < 2) steps = 2;
+    const double h = 0.02; /* 6 cm cube */
+    build_lattice(h);
+
+    /* ---- version, status strings, last error ---- */
+    CHECK(ts_version() == TISSUESIM_VERSION);
+    CHECK(ts_version() ==
+          TISSUESIM_VERSION_MAJOR * 10000 + TISSUESIM_VERSION_MINOR * 100 + TISSUESIM_VERSION_PATCH);
+    CHECK(strcmp(ts_version_string(), TISSUESIM_VERSION_STRING) == 0);
+    CHECK(strncmp(ts_status_string(TS_STATUS_OK), "TS_STATUS_OK", 12) == 0);
+    CHECK(strncmp(ts_status_string(TS_STATUS_BAD_STATE), "TS_STATUS_BAD_STATE", 19) == 0);
+    CHECK(strcmp(ts_status_string(12345), "unknown ts_status value") == 0);
+    CHECK(TS_STATUS_OK == 0 && TS_STATUS_NULL_PARAMETER == 1 && TS_STATUS_PANIC == 11);
+    ts_last_error_clear();
+    CHECK(ts_last_error_message(NULL, 0) == 0);
+
+    /* ---- defaults ---- */
+    ts_settings settings;
+    ts_material material;
+    ts_body_options body_options;
+    ts_tool_options tool_options;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK(settings.dt == 1e-3 && settings.gravity[1] < 0 && settings.min_substeps >= 1);
+    CHECK(settings.contact_mode == TS_CONTACT_MODE_EXACT_SHAPE);
+    CHECK(settings.volume_constraints == 1 && settings.self_contact == 0);
+    CHECK(settings.mass_scaling == 1);
+    CHECK_OK(ts_material_default(&material));
+    CHECK(material.youngs_modulus == 5000 && material.poisson_ratio == 0.45 &&
+          material.density == 1060);
+    CHECK_OK(ts_body_options_default(&body_options));
+    CHECK(body_options.support_radius == 0 && body_options.target_neighbours > 0);
+    CHECK_OK(ts_tool_options_default(&tool_options));
+    CHECK(tool_options.friction_static == 0 && tool_options.sample_spacing == 0);
+    CHECK_ST(ts_settings_default(NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK(ts_last_error_message(NULL, 0) > 0);
+    {
+        char small[4] = {'#', '#', '#', '#'};
+        size_t full = ts_last_error_message(small, 3);
+        CHECK(full > 3 && small[2] == '\0' && small[3] == '#');
+    }
+    CHECK_ST(ts_material_default(NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_body_options_default(NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_tool_options_default(NULL), TS_STATUS_NULL_PARAMETER);
+
+    /* ---- world ---- */
+    ts_world *world = NULL;
+    ts_world_free(NULL);
+    CHECK_ST(ts_world_new(NULL, &world), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_world_new(&settings, NULL), TS_STATUS_NULL_PARAMETER);
+    {
+        ts_settings bad = settings;
+        bad.dt = NAN;
+        CHECK_ST(ts_world_new(&bad, &world), TS_STATUS_NON_FINITE);
+        CHECK(last_error_has("dt"));
+        bad = settings;
+        bad.iterations = 0;
+        CHECK_ST(ts_world_new(&bad, &world), TS_STATUS_INVALID_ARGUMENT);
+        CHECK(world == NULL);
+    }
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK(world != NULL);
+    {
+        ts_settings got;
+        CHECK_OK(ts_world_get_settings(world, &got));
+        CHECK(got.dt == settings.dt && got.max_substeps == settings.max_substeps);
+        got.damping_mass = 1.0;
+        CHECK_OK(ts_world_set_settings(world, &got));
+        got.gravity[2] = INFINITY;
+        CHECK_ST(ts_world_set_settings(world, &got), TS_STATUS_NON_FINITE);
+        ts_settings again;
+        CHECK_OK(ts_world_get_settings(world, &again));
+        CHECK(again.damping_mass == 1.0 && again.gravity[2] == 0);
+        CHECK_OK(ts_world_set_settings(world, &settings));
+    }
+    uint32_t count = 99;
+    CHECK_OK(ts_world_body_count(world, &count));
+    CHECK(count == 0);
+    CHECK_OK(ts_world_tool_count(world, &count));
+    CHECK(count == 0);
+
+    /* ---- bodies ---- */
+    uint32_t body = 99, organ = 99, from_file = 99;
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, &body_options,
+                                           &body));
+    CHECK(body == 0);
+    CHECK_ST(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, NULL, NULL, &body),
+             TS_STATUS_NULL_PARAMETER);
+    {
+        double bad_nodes[3 * NN];
+        memcpy(bad_nodes, nodes, sizeof bad_nodes);
+        bad_nodes[5] = NAN;
+        uint32_t id = 77;
+        CHECK_ST(ts_world_add_body_from_arrays(world, bad_nodes, NN, tets, NT, &material, NULL, &id),
+                 TS_STATUS_NON_FINITE);
+        uint32_t bad_tets[4 * NT];
+        memcpy(bad_tets, tets, sizeof bad_tets);
+        bad_tets[0] = NN + 10;
+        CHECK_ST(ts_world_add_body_from_arrays(world, nodes, NN, bad_tets, NT, &material, NULL, &id),
+                 TS_STATUS_MESH_ERROR);
+        CHECK(id == 77);
+    }
+    CHECK_OK(ts_world_add_default_organ(world, &material, NULL, &organ));
+    CHECK(organ == 1);
+
+    char vtk_path[256], obj_path[256], bad_path[256];
+    snprintf(vtk_path, sizeof vtk_path, "/tmp/ts_test_api_%ld.vtk", (long)getpid());
+    snprintf(obj_path, sizeof obj_path, "/tmp/ts_test_api_%ld.obj", (long)getpid());
+    snprintf(bad_path, sizeof bad_path, "/tmp/ts_test_api_%ld_broken.msh", (long)getpid());
+    {
+        /* The lattice as legacy VTK, in cm, moved 20 cm further along x. */
+        static char text[65536];
+        size_t len = 0;
+        len += (size_t)snprintf(text + len, sizeof text - len,
+                                "# vtk DataFile Version 2.0\nlattice\nASCII\n"
+                                "DATASET UNSTRUCTURED_GRID\nPOINTS %d double\n",
+                                NN);
+        for (int i = 0; i < NN; i++)
+            len += (size_t)snprintf(text + len, sizeof text - len, "%g %g %g\n",
+                                    100 * (nodes[3 * i] + 0.2), 100 * nodes[3 * i + 1],
+                                    100 * nodes[3 * i + 2]);
+        len += (size_t)snprintf(text + len, sizeof text - len, "CELLS %d %d\n", NT, 5 * NT);
+        for (int t = 0; t < NT; t++)
+            len += (size_t)snprintf(text + len, sizeof text - len, "4 %u %u %u %u\n", tets[4 * t],
+                                    tets[4 * t + 1], tets[4 * t + 2], tets[4 * t + 3]);
+        len += (size_t)snprintf(text + len, sizeof text - len, "CELL_TYPES %d\n", NT);
+        for (int t = 0; t < NT; t++) len += (size_t)snprintf(text + len, sizeof text - len, "10\n");
+        write_file(vtk_path, text);
+        write_file(obj_path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                             "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+        write_file(bad_path, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0\n");
+    }
+    CHECK_OK(ts_world_add_body_from_file(world, vtk_path, 0.01, &material, NULL, &from_file));
+    CHECK(from_file == 2);
+    {
+        uint32_t id = 55;
+        CHECK_ST(ts_world_add_body_from_file(world, bad_path, 1.0, &material, NULL, &id),
+                 TS_STATUS_MESH_ERROR);
+        CHECK(last_error_has("_broken.msh"));
+        CHECK_ST(ts_world_add_body_from_file(world, "/nonexistent/liver.msh", 1.0, &material, NULL,
+                                             &id),
+                 TS_STATUS_MESH_ERROR);
+        CHECK(last_error_has("/nonexistent/liver.msh"));
+        CHECK_ST(ts_world_add_body_from_file(world, vtk_path, -1.0, &material, NULL, &id),
+                 TS_STATUS_INVALID_ARGUMENT);
+        CHECK(id == 55);
+    }
+    CHECK_OK(ts_world_body_count(world, &count));
+    CHECK(count == 3);
+
+    size_t n = 0, fixed = 0;
+    CHECK_OK(ts_body_particle_count(world, body, &n));
+    CHECK(n == NN);
+    {
+        /* Fix the bottom face (y = 0) of the lattice by box and one more particle by index. */
+        double lo[3] = {OX - 0.01, -1e-9, -1}, hi[3] = {OX + 0.1, 1e-9, 1};
+        CHECK_OK(ts_body_fix_box(world, body, lo, hi, &fixed));
+        CHECK(fixed == (CELLS + 1) * (CELLS + 1));
+        uint32_t idx[2] = {node_id(0, 1, 0), node_id(CELLS, 1, CELLS)};
+        CHECK_OK(ts_body_fix_particles(world, body, idx, 2));
+        uint32_t bad_idx[1] = {NN};
+        CHECK_ST(ts_body_fix_particles(world, body, bad_idx, 1), TS_STATUS_INVALID_ARGUMENT);
+        CHECK_ST(ts_body_fix_particles(world, 42, idx, 2), TS_STATUS_UNKNOWN_BODY);
+        double nan_lo[3] = {NAN, 0, 0};
+        CHECK_ST(ts_body_fix_box(world, body, nan_lo, hi, NULL), TS_STATUS_NON_FINITE);
+        /* Fix the organ's and the file body's lowest 10 % so that they stay put. */
+        double olo[3] = {-10, -10, -10}, ohi[3] = {10, -10 + 1e-9, 10};
+        double *ox;
+        size_t on;
+        CHECK_OK(ts_body_particle_count(world, organ, &on));
+        ox = malloc(3 * on * sizeof *ox);
+        CHECK_OK(ts_body_positions(world, organ, ox, 3 * on));
+        double ymin = 1e9, ymax = -1e9;
+        for (size_t i = 0; i < on; i++) {
+            if (ox[3 * i + 1] < ymin) ymin = ox[3 * i + 1];
+            if (ox[3 * i + 1] > ymax) ymax = ox[3 * i + 1];
+        }
+        ohi[1] = ymin + 0.1 * (ymax - ymin);
+        size_t ofixed = 0;
+        CHECK_OK(ts_body_fix_box(world, organ, olo, ohi, &ofixed));
+        CHECK(ofixed > 0);
+        free(ox);
+        lo[0] += 0.2;
+        hi[0] += 0.2;
+        CHECK_OK(ts_body_fix_box(world, from_file, lo, hi, &fixed));
+        CHECK(fixed == (CELLS + 1) * (CELLS + 1));
+    }
+
+    double *x = malloc(3 * n * sizeof *x), *x_after = malloc(3 * n * sizeof *x);
+    double *v = malloc(3 * n * sizeof *v), *x_rest = malloc(3 * n * sizeof *x);
+    uint32_t *src = malloc(n * sizeof *src);
+    CHECK_OK(ts_body_positions(world, body, x, 3 * n));
+    CHECK(x[3 * node_id(1, 2, 3) + 2] == 3 * h);
+    CHECK_OK(ts_body_rest_positions(world, body, x_rest, 3 * n));
+    CHECK(memcmp(x, x_rest, 3 * n * sizeof *x) == 0);
+    CHECK_OK(ts_body_velocities(world, body, v, 3 * n));
+    CHECK(v[0] == 0 && v[3 * n - 1] == 0);
+    CHECK_OK(ts_body_source_indices(world, body, src, n));
+    CHECK(src[0] == 0 && src[n - 1] == n - 1);
+    {
+        /* Short buffers: status, nothing written. */
+        double probe[4] = {-7, -7, -7, -7};
+        CHECK_ST(ts_body_positions(world, body, probe, 3), TS_STATUS_BUFFER_TOO_SMALL);
+        CHECK(last_error_has("needed"));
+        CHECK_ST(ts_body_velocities(world, body, probe, 3 * n - 1), TS_STATUS_BUFFER_TOO_SMALL);
+        CHECK_ST(ts_body_rest_positions(world, body, probe, 0), TS_STATUS_BUFFER_TOO_SMALL);
+        uint32_t iprobe[2] = {7, 7};
+        CHECK_ST(ts_body_source_indices(world, body, iprobe, 1), TS_STATUS_BUFFER_TOO_SMALL);
+        CHECK_ST(ts_body_boundary_triangles(world, body, iprobe, 2), TS_STATUS_BUFFER_TOO_SMALL);
+        CHECK_ST(ts_body_tets(world, body, iprobe, 2), TS_STATUS_BUFFER_TOO_SMALL);
+        CHECK(probe[0] == -7 && probe[3] == -7 && iprobe[0] == 7 && iprobe[1] == 7);
+        CHECK_ST(ts_body_positions(world, 7, x, 3 * n), TS_STATUS_UNKNOWN_BODY);
+        CHECK_ST(ts_body_positions(world, body, NULL, 3 * n), TS_STATUS_NULL_PARAMETER);
+        CHECK_ST(ts_body_positions(NULL, body, x, 3 * n), TS_STATUS_NULL_PARAMETER);
+    }
+    size_t ntri = 0, ntet = 0;
+    CHECK_OK(ts_body_boundary_triangle_count(world, body, &ntri));
+    CHECK(ntri == 6 * 2 * CELLS * CELLS);
+    CHECK_OK(ts_body_tet_count(world, body, &ntet));
+    CHECK(ntet == NT);
+    {
+        uint32_t *tri = malloc(3 * ntri * sizeof *tri), *tt = malloc(4 * ntet * sizeof *tt);
+        CHECK_OK(ts_body_boundary_triangles(world, body, tri, 3 * ntri));
+        int in_range = 1;
+        for (size_t i = 0; i < 3 * ntri; i++) in_range &= tri[i] < n;
+        CHECK(in_range);
+        /* Outward normals: the triangles' signed volume about the centroid is positive. */
+        double sv = 0, c = 0.5 * CELLS * h, cx = OX + c;
+        for (size_t t = 0; t < ntri; t++) {
+            const double *a = &x[3 * tri[3 * t]], *b = &x[3 * tri[3 * t + 1]],
+                         *d = &x[3 * tri[3 * t + 2]];
+            double ax = a[0] - cx, ay = a[1] - c, az = a[2] - c, bx = b[0] - cx, by = b[1] - c,
+                   bz = b[2] - c, dx = d[0] - cx, dy = d[1] - c, dz = d[2] - c;
+            sv += ax * (by * dz - bz * dy) - ay * (bx * dz - bz * dx) + az * (bx * dy - by * dx);
+        }
+        CHECK(fabs(sv / 6 - pow(CELLS * h, 3)) < 1e-12);
+        CHECK_OK(ts_body_tets(world, body, tt, 4 * ntet));
+        in_range = 1;
+        for (size_t i = 0; i < 4 * ntet; i++) in_range &= tt[i] < n;
+        CHECK(in_range);
+        free(tri);
+        free(tt);
+    }
+    double vol = 0, rest = 0, mass = 0, disp = -1;
+    CHECK_OK(ts_body_volume(world, body, &vol));
+    CHECK_OK(ts_body_rest_volume(world, body, &rest));
+    CHECK(fabs(rest - pow(CELLS * h, 3)) < 1e-12 && fabs(vol - rest) < 1e-12);
+    CHECK_OK(ts_body_mass(world, body, &mass));
+    CHECK(fabs(mass - material.density * rest) < 1e-9);
+    double added = -1;
+    CHECK_OK(ts_body_added_mass(world, body, &added));
+    CHECK(added >= 0);
+    CHECK_OK(ts_body_max_displacement(world, body, &disp));
+    CHECK(disp == 0);
+    CHECK_OK(ts_body_rest_volume(world, from_file, &rest));
+    CHECK(fabs(rest - pow(CELLS * h, 3)) < 1e-12);
+
+    /* ---- tools ---- */
+    ts_pose above = {{OX + CELLS * h / 2, CELLS * h + 0.011, CELLS * h / 2}, {1, 0, 0, 0}};
+    ts_pose far = {{1.0, 1.0, 1.0}, {0.5, 0.5, 0.5, 0.5}};
+    uint32_t sphere = 99, capsule = 99, cylinder = 99, box = 99, mesh = 99;
+    CHECK_OK(ts_world_add_tool_sphere(world, 0.01, &above, NULL, &sphere));
+    CHECK(sphere == 0);
+    CHECK_OK(ts_world_add_tool_capsule(world, 0.02, 0.005, &far, &tool_options, &capsule));
+    CHECK(capsule == 1);
+    CHECK_OK(ts_world_add_tool_cylinder(world, 0.02, 0.005, &far, NULL, &cylinder));
+    CHECK(cylinder == 2);
+    {
+        double half[3] = {0.01, 0.02, 0.03};
+        CHECK_OK(ts_world_add_tool_box(world, half, &far, NULL, &box));
+        CHECK(box == 3);
+        half[1] = -1;
+        uint32_t id = 66;
+        CHECK_ST(ts_world_add_tool_box(world, half, &far, NULL, &id), TS_STATUS_INVALID_ARGUMENT);
+        CHECK_ST(ts_world_add_tool_box(world, NULL, &far, NULL, &id), TS_STATUS_NULL_PARAMETER);
+        CHECK_ST(ts_world_add_tool_sphere(world, -0.01, &far, NULL, &id),
+                 TS_STATUS_INVALID_ARGUMENT);
+        CHECK_ST(ts_world_add_tool_capsule(world, 0.01, NAN, &far, NULL, &id),
+                 TS_STATUS_NON_FINITE);
+        CHECK_ST(ts_world_add_tool_cylinder(world, 0.01, 0.01, NULL, NULL, &id),
+                 TS_STATUS_NULL_PARAMETER);
+        CHECK_ST(ts_world_add_tool_mesh_file(world, "/nonexistent/probe.obj", 1, &far, NULL, &id),
+                 TS_STATUS_MESH_ERROR);
+        CHECK(last_error_has("/nonexistent/probe.obj"));
+        CHECK(id == 66);
+    }
+    CHECK_OK(ts_world_add_tool_mesh_file(world, obj_path, 0.01, &far, NULL, &mesh));
+    CHECK(mesh == 4);
+    CHECK_OK(ts_world_tool_count(world, &count));
+    CHECK(count == 5);
+    {
+        ts_pose got;
+        CHECK_OK(ts_tool_get_pose(world, capsule, &got));
+        CHECK(got.position[0] == 1.0 && fabs(got.orientation[0] - 0.5) < 1e-15);
+        ts_pose zero = {{0, 0, 0}, {0, 0, 0, 0}}, nan_pose = above;
+        nan_pose.orientation[2] = NAN;
+        CHECK_ST(ts_tool_set_pose(world, sphere, &zero), TS_STATUS_INVALID_ARGUMENT);
+        CHECK_ST(ts_tool_set_pose(world, sphere, &nan_pose), TS_STATUS_NON_FINITE);
+        CHECK_ST(ts_tool_set_pose(world, 17, &above), TS_STATUS_UNKNOWN_TOOL);
+        CHECK_OK(ts_tool_get_pose(world, sphere, &got));
+        CHECK(memcmp(&got, &above, sizeof got) == 0);
+    }
+
+    /* ---- stepping: press the sphere into the lattice ---- */
+    ts_step_report report = {0, 0};
+    for (long s = 0; s < steps; s++) {
+        ts_pose p = above;
+        p.position[1] -= 0.006 * (double)(s + 1) / (double)steps;
+        CHECK_OK(ts_tool_set_pose(world, sphere, &p));
+        CHECK_OK(ts_world_step(world, &report));
+    }
+    CHECK(report.substeps >= 1);
+    double t = 0;
+    CHECK_OK(ts_world_time(world, &t));
+    CHECK(fabs(t - (double)steps * settings.dt) < 1e-12);
+    uint64_t diverged = 99;
+    CHECK_OK(ts_world_diverged_steps(world, &diverged));
+    CHECK(diverged == 0);
+    ts_wrench w;
+    CHECK_OK(ts_tool_wrench(world, sphere, &w));
+    CHECK(w.contact_count > 0 && w.force[1] > 0); /* the tissue pushes the probe up */
+    uint32_t contacts = 0;
+    CHECK_OK(ts_tool_contact_count(world, sphere, &contacts));
+    CHECK(contacts == w.contact_count);
+    CHECK_OK(ts_tool_wrench(world, box, &w));
+    CHECK(w.contact_count == 0 && w.force[0] == 0 && w.force[1] == 0 && w.force[2] == 0);
+    CHECK_ST(ts_tool_wrench(world, 99, &w), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_OK(ts_body_max_displacement(world, body, &disp));
+    CHECK(disp > 0 && disp < 0.05);
+    CHECK_OK(ts_body_volume(world, body, &vol));
+    CHECK_OK(ts_body_rest_volume(world, body, &rest));
+    CHECK(fabs(vol / rest - 1) < 0.05);
+
+    /* ---- state: save, step, restore, step again: bit-identical ---- */
+    size_t size = 0, written = 0;
+    CHECK_OK(ts_world_state_size(world, &size));
+    CHECK(size > 0);
+    unsigned char *state = malloc(size), *junk = malloc(size);
+    CHECK_ST(ts_world_save_state(world, state, size - 1, &written), TS_STATUS_BUFFER_TOO_SMALL);
+    CHECK(written == 0);
+    CHECK_OK(ts_world_save_state(world, state, size, &written));
+    CHECK(written == size);
+    for (long s = 0; s < steps; s++) CHECK_OK(ts_world_step(world, NULL));
+    CHECK_OK(ts_body_positions(world, body, x, 3 * n));
+    CHECK_OK(ts_world_restore_state(world, state, size));
+    for (long s = 0; s < steps; s++) CHECK_OK(ts_world_step(world, NULL));
+    CHECK_OK(ts_body_positions(world, body, x_after, 3 * n));
+    CHECK(memcmp(x, x_after, 3 * n * sizeof *x) == 0);
+    /* Bad states are rejected and change nothing. */
+    for (size_t i = 0; i < size; i++) junk[i] = (unsigned char)(i * 37 + 11);
+    CHECK_ST(ts_world_restore_state(world, junk, size), TS_STATUS_BAD_STATE);
+    CHECK_ST(ts_world_restore_state(world, state, size / 2), TS_STATUS_BAD_STATE);
+    CHECK_ST(ts_world_restore_state(world, state, 0), TS_STATUS_BAD_STATE);
+    CHECK_ST(ts_world_restore_state(world, NULL, size), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_body_positions(world, body, x_after, 3 * n));
+    CHECK(memcmp(x, x_after, 3 * n * sizeof *x) == 0);
+    free(state);
+    free(junk);
+
+    ts_world_free(world);
+    free(x);
+    free(x_after);
+    free(v);
+    free(x_rest);
+    free(src);
+    remove(vtk_path);
+    remove(obj_path);
+    remove(bad_path);
+
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed == 0 ? 0 : 1;
+}
