@@ -48,6 +48,17 @@ for fn in $(grep -oE '\bts_[a-z0-9_]+\(' include/tissuesim.h | tr -d '(' | sort 
 done
 if [ -z "$missing" ]; then pass "test_api.c covers the header"; else fail "test_api.c misses:$missing"; fi
 
+echo "== checking the shared library exports exactly the header's functions"
+if command -v nm >/dev/null 2>&1; then
+    exported="$(nm -D --defined-only "$LIB_DIR/libtissuesim.so" | awk '$2 == "T" {print $3}' | sort -u)"
+    declared="$(grep -oE '\bts_[a-z0-9_]+\(' include/tissuesim.h | tr -d '(' | sort -u)"
+    if [ "$exported" = "$declared" ]; then
+        pass "exports = header ($(echo "$declared" | wc -l) functions)"
+    else
+        fail "exports differ from the header: $(diff <(echo "$declared") <(echo "$exported") | grep '^[<>]' | tr '\n' ' ')"
+    fi
+fi
+
 echo "== compiling"
 PROGRAMS=(hello haptic_loop sofa_liver test_api)
 for p in "${PROGRAMS[@]}"; do
