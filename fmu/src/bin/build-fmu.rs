@@ -6,8 +6,10 @@
 //! cargo run --release -p tissuesim-fmu --bin build-fmu -- [--out PATH] [--lib PATH] [--keep-debug]
 //! ```
 //!
-//! `cargo run` builds the package's cdylib next to this program (`target/release/`), which is
-//! where the library is taken from unless `--lib` names another. The default output is
+//! Unless `--lib` names a library, the program first runs `cargo build --release -p
+//! tissuesim-fmu --lib` (with the `cargo` that started it, so `CARGO_TARGET_DIR` is honoured;
+//! `cargo run` alone does not copy a cdylib to `target/release/`) and packages
+//! `<target dir>/release/libTissueSim.so`. The default output is
 //! `<target dir>/fmu/TissueSim.fmu`. Debug info is stripped from the packaged copy with
 //! `strip --strip-debug` when that tool exists (`--keep-debug` keeps it).
 
@@ -64,23 +66,35 @@ fn run() -> Result<PathBuf, String> {
     let args = parse_args()?;
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let exe_dir = exe.parent().ok_or("no executable directory")?.to_path_buf();
+    // The program lives in <target dir>/<profile>/.
+    let target_dir = exe_dir.parent().unwrap_or(&exe_dir).to_path_buf();
     let (plat, prefix, ext) = platform();
-    let lib = args
-        .lib
-        .unwrap_or_else(|| exe_dir.join(format!("{prefix}TissueSim.{ext}")));
+    let lib = match args.lib {
+        Some(lib) => lib,
+        None => {
+            let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+            let status = Command::new(&cargo)
+                .args(["build", "--release", "-p", "tissuesim-fmu", "--lib"])
+                .env("CARGO_TARGET_DIR", &target_dir)
+                .status()
+                .map_err(|e| format!("cannot run {cargo:?}: {e}"))?;
+            if !status.success() {
+                return Err("cargo build --release -p tissuesim-fmu --lib failed".into());
+            }
+            target_dir
+                .join("release")
+                .join(format!("{prefix}TissueSim.{ext}"))
+        }
+    };
     let lib_bytes = fs::read(&lib).map_err(|e| {
         format!(
             "cannot read the shared library {}: {e} (build it with `cargo build --release -p tissuesim-fmu`)",
             lib.display()
         )
     })?;
-    let out = args.out.unwrap_or_else(|| {
-        exe_dir
-            .parent()
-            .unwrap_or(&exe_dir)
-            .join("fmu")
-            .join("TissueSim.fmu")
-    });
+    let out = args
+        .out
+        .unwrap_or_else(|| target_dir.join("fmu").join("TissueSim.fmu"));
     let staging = out.with_extension("fmu.d");
     let _ = fs::remove_dir_all(&staging);
     fs::create_dir_all(staging.join("resources")).map_err(|e| e.to_string())?;

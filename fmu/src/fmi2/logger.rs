@@ -4,10 +4,11 @@
 //! with `%` escaped as `%%` (and no further argument), so masters that format it (fmpy, most C
 //! masters) print it intact.
 //!
-//! Categories (declared in `modelDescription.xml`): messages of status error/fatal are always
-//! delivered unless their category was switched off by name through `fmi2SetDebugLogging`;
-//! everything else only when debug logging is on for its category (`loggingOn` of
-//! `fmi2Instantiate`, or `fmi2SetDebugLogging`).
+//! Categories (declared in `modelDescription.xml`): the status categories (`logStatusWarning`,
+//! `logStatusDiscard`, `logStatusError`, `logStatusFatal`: why a call did not return fmi2OK) are
+//! on from the start, whatever `loggingOn` says, and can be switched off only by naming them in
+//! `fmi2SetDebugLogging`. The debug categories (`logCalls`, `logModel`) follow `loggingOn` of
+//! `fmi2Instantiate` and `fmi2SetDebugLogging` (with no category named: all debug categories).
 
 use super::types::{Fmi2CallbackLogger, Fmi2ComponentEnvironment, Fmi2Status};
 use std::ffi::CString;
@@ -53,13 +54,23 @@ impl Category {
     /// What it holds.
     pub fn description(self) -> &'static str {
         match self {
-            Category::StatusWarning => "Log messages of calls that return fmi2Warning",
-            Category::StatusDiscard => "Log messages of calls that return fmi2Discard",
-            Category::StatusError => "Log messages of calls that return fmi2Error (on by default)",
-            Category::StatusFatal => "Log messages of calls that return fmi2Fatal (on by default)",
-            Category::Calls => "Log every FMI function call",
-            Category::Model => "Log what the model does: world built, substeps, solver reports",
+            Category::StatusWarning => "Warnings (on unless switched off by name)",
+            Category::StatusDiscard => {
+                "Why fmi2DoStep returned fmi2Discard (on unless switched off by name)"
+            }
+            Category::StatusError => {
+                "Why a call returned fmi2Error (on unless switched off by name)"
+            }
+            Category::StatusFatal => {
+                "Why a call returned fmi2Fatal (on unless switched off by name)"
+            }
+            Category::Calls => "Debug: every FMI call with its arguments",
+            Category::Model => "Debug: what the model does (world built, mesh, fixed nodes)",
         }
+    }
+    /// True for the debug categories (`logCalls`, `logModel`), false for the status ones.
+    pub fn is_debug(self) -> bool {
+        matches!(self, Category::Calls | Category::Model)
     }
     /// The category by name.
     pub fn from_name(name: &str) -> Option<Category> {
@@ -104,7 +115,7 @@ impl Logger {
             callback,
             environment,
             instance_name: CString::new(escape_nul(instance_name)).unwrap_or_default(),
-            enabled: [false; Category::ALL.len()],
+            enabled: Category::ALL.map(|c| !c.is_debug()),
         };
         logger.set_all(logging_on);
         logger
@@ -112,14 +123,15 @@ impl Logger {
 
     fn set_all(&mut self, on: bool) {
         for c in Category::ALL {
-            let always = matches!(c, Category::StatusError | Category::StatusFatal);
-            self.enabled[c as usize] = on || always;
+            if c.is_debug() {
+                self.enabled[c as usize] = on;
+            }
         }
     }
 
-    /// `fmi2SetDebugLogging`: with no category, debug logging on/off for all of them (error
-    /// and fatal messages stay on); otherwise on/off for the named ones. An unknown name is an
-    /// error (nothing changed).
+    /// `fmi2SetDebugLogging`: with no category, every debug category on/off (the status
+    /// categories are not debug logging and stay as they are); otherwise on/off for the named
+    /// ones. An unknown name is an error (nothing changed).
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> Result<(), String> {
         if categories.is_empty() {
             self.set_all(on);
@@ -245,11 +257,15 @@ mod tests {
         let mut log = Logger::new(Some(recorder()), std::ptr::null_mut(), "i", false);
         log.info("hidden");
         log.error("shown 50%");
+        log.warning("warning on");
         assert!(log
             .set_debug_logging(true, &["logModel".to_string()])
             .is_ok());
         log.info("model on");
-        log.warning("warning still off");
+        log.log(Fmi2Status::Ok, Category::Calls, "calls still off");
+        log.set_debug_logging(false, &["logStatusWarning".to_string()])
+            .unwrap();
+        log.warning("warning off by name");
         assert!(log.set_debug_logging(true, &["nope".to_string()]).is_err());
         log.set_debug_logging(false, &["logStatusError".to_string()])
             .unwrap();
@@ -259,6 +275,7 @@ mod tests {
             seen,
             vec![
                 (3, "logStatusError".into(), "shown 50%%".into()),
+                (1, "logStatusWarning".into(), "warning on".into()),
                 (0, "logModel".into(), "model on".into()),
             ]
         );
