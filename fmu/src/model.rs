@@ -767,6 +767,21 @@ mod tests {
         assert_eq!(VARIABLES.len(), vr::GRAVITY_Z as usize + 1);
     }
 
+    /// docs/FMU.md documents every variable, in table order.
+    #[test]
+    fn docs_list_every_variable() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/FMU.md");
+        let docs = std::fs::read_to_string(&path).unwrap();
+        let mut from = 0;
+        for v in VARIABLES {
+            let row = format!("| `{}` | {} |", v.name, v.vr);
+            let at = docs[from..]
+                .find(&row)
+                .unwrap_or_else(|| panic!("{} does not document {row}", path.display()));
+            from += at;
+        }
+    }
+
     #[test]
     fn substep_count() {
         assert_eq!(substeps(1e-3, 1e-3).unwrap(), 1);
