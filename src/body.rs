@@ -73,6 +73,9 @@ pub struct Body {
     pub(crate) p: Vec<Vec3>,
     /// Forces of the current substep (N); scratch.
     pub(crate) force: Vec<Vec3>,
+    /// Per-neighbourhood scratch of the force computation (one entry per pair of the largest
+    /// neighbourhood).
+    pub(crate) pair_scratch: Vec<Vec3>,
     /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
     pub(crate) mass: Vec<Real>,
     /// Inertial masses (kg): the physical mass plus any mass scaling.
@@ -94,6 +97,8 @@ pub struct Body {
     pub(crate) boundary: Vec<[u32; 3]>,
     pub(crate) particle_radius: Real,
     pub(crate) rest_volume: Real,
+    /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ disables them.
+    pub(crate) volume_compliance: Real,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
     /// Copies of `x`, `v`, `rotation` taken at the start of a step, restored if it diverges.
@@ -102,8 +107,9 @@ pub struct Body {
     pub(crate) saved_rotation: Vec<Quat>,
 }
 
-/// Rotation-extraction iterations per particle per substep (warm-started, so 1–3 suffice).
-pub(crate) const ROTATION_ITERATIONS: u32 = 4;
+/// Newton iterations of the rotation extraction per particle per substep before the exact SVD
+/// fallback (warm-started, they converge in 1–3).
+pub(crate) const ROTATION_ITERATIONS: u32 = 6;
 
 impl Body {
     /// Build a body from a cleaned mesh (positions in m) under the world's `settings`.
@@ -115,15 +121,24 @@ impl Body {
         let m = &options.material;
         let bad = |s: String| Err(Error::InvalidArgument(s));
         if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
-            return bad(format!("Young's modulus must be > 0 Pa, got {}", m.youngs_modulus));
+            return bad(format!(
+                "Young's modulus must be > 0 Pa, got {}",
+                m.youngs_modulus
+            ));
         }
         if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-            return bad(format!("Poisson ratio must be in (-1, 0.5), got {}", m.poisson_ratio));
+            return bad(format!(
+                "Poisson ratio must be in (-1, 0.5), got {}",
+                m.poisson_ratio
+            ));
         }
         if !(m.density.is_finite() && m.density > 0.0) {
             return bad(format!("density must be > 0 kg/m3, got {}", m.density));
         }
-        for r in [options.support_radius, options.particle_radius].into_iter().flatten() {
+        for r in [options.support_radius, options.particle_radius]
+            .into_iter()
+            .flatten()
+        {
             if !(r.is_finite() && r > 0.0) {
                 return bad(format!("radii must be finite and > 0 m, got {r}"));
             }
@@ -173,6 +188,7 @@ impl Body {
             v: vec![Vec3::zeros(); n],
             p: mesh.nodes.clone(),
             force: vec![Vec3::zeros(); n],
+            pair_scratch: vec![Vec3::zeros(); max_neighbours(&nbr)],
             inv_mass: vec![0.0; n],
             inertial_mass: mass.clone(),
             mass,
@@ -187,6 +203,7 @@ impl Body {
             boundary: mesh.boundary_triangles(),
             particle_radius,
             omega_max: 0.0,
+            volume_compliance: 0.0,
             saved_x: mesh.nodes.clone(),
             saved_v: vec![Vec3::zeros(); n],
             saved_rotation: vec![Quat::identity(); n],
@@ -268,6 +285,11 @@ impl Body {
     pub fn mass(&self) -> Real {
         self.mass.iter().sum()
     }
+    /// The elastic model in force: Lamé parameters of the particle stress (λ is 0 when the
+    /// volumetric split moves it into the volume constraints), hourglass and damping terms.
+    pub fn elastic_model(&self) -> &ElasticModel {
+        &self.model
+    }
     /// The material.
     pub fn material(&self) -> &Material {
         &self.material
@@ -288,6 +310,7 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.x.len()];
         let mut rotation = vec![Quat::identity(); self.x.len()];
+        let mut scratch = vec![Vec3::zeros(); max_neighbours(&self.nbr)];
         let zero = vec![Vec3::zeros(); self.x.len()];
         let input = ForceInputs {
             nbr: &self.nbr,
@@ -295,7 +318,14 @@ impl Body {
             x: positions,
             v: &zero,
         };
-        elastic::accumulate_forces(&self.model, &input, &mut rotation, 50, &mut force);
+        elastic::accumulate_forces(
+            &self.model,
+            &input,
+            &mut rotation,
+            50,
+            &mut scratch,
+            &mut force,
+        );
         force
     }
 
@@ -309,6 +339,11 @@ impl Body {
             settings.hourglass_stiffness,
             settings.damping_stiffness,
         );
+        self.volume_compliance = settings.volume_compliance;
+        if settings.volume_constraints && settings.volumetric_split {
+            self.volume_compliance += 1.0 / self.model.lambda;
+            self.model.lambda = 0.0;
+        }
         self.inertial_mass.copy_from_slice(&self.mass);
         self.update_inverse_masses();
         self.omega_max = crate::stability::max_angular_frequency(self);
@@ -323,7 +358,12 @@ impl Body {
                 if self.omega_max <= omega_target {
                     break;
                 }
-                for ((mi, m0), k) in self.inertial_mass.iter_mut().zip(&self.mass).zip(&stiffness) {
+                for ((mi, m0), k) in self
+                    .inertial_mass
+                    .iter_mut()
+                    .zip(&self.mass)
+                    .zip(&stiffness)
+                {
                     *mi = m0.max(factor * k / (omega_target * omega_target));
                 }
                 self.update_inverse_masses();
@@ -369,6 +409,14 @@ impl Body {
         self.inv_mass[i] = 0.0;
         self.v[i] = Vec3::zeros();
     }
+}
+
+/// Number of pairs of the largest neighbourhood.
+fn max_neighbours(nbr: &Neighbourhoods) -> usize {
+    (0..nbr.particle_count())
+        .map(|i| nbr.range(i).len())
+        .max()
+        .unwrap_or(0)
 }
 
 /// Sum of the signed volumes (m³) of `tets` at positions `x`.

@@ -6,7 +6,7 @@
 //! 1. `F_i = I + Σ_j (x_ij - u_ij) d_ijᵀ` (= `Σ_j x_ij d_ijᵀ`, eq. 1–2, written in displacements
 //!    for round-off), see [`crate::neighbours`];
 //! 2. `R_i` = the rotation that maximises `tr(Rᵀ F_i)` over proper rotations, found by the
-//!    iterative method of Müller et al. (2016) warm-started from the previous step. This is
+//!    objective of Müller et al. (2016) with Newton steps, warm-started from the previous step. This is
 //!    `U diag(1, 1, det(UVᵀ)) Vᵀ` of the SVD `F = U Σ Vᵀ`: Irving et al.'s inversion handling
 //!    (one singular value negated when `F` is inverted);
 //! 3. first Piola–Kirchhoff stress of the corotated model (eq. 3, `P = U P̂ Vᵀ` with
@@ -15,9 +15,12 @@
 //!    `f_j -= g_ij`: equal and opposite, so linear momentum is conserved pair by pair, and
 //!    `P Fᵀ` symmetric makes the total torque vanish.
 //!
-//! Hourglass control (after Ganzenmüller 2015): the part of a pair's current offset that `F_i`
-//! does not explain, `δ_ij = (F_i u_ij - x_ij)·x̂_ij`, drives a central force of stiffness
-//! `c_ij = c_hg E v_i ŵ_ij / |u_ij|²` (N/m), `ŵ` the normalised kernel weight. It vanishes under any affine motion.
+//! Hourglass control (in the spirit of Ganzenmüller 2015): the part of a pair's current offset
+//! that `F_i` does not explain, `ε_ij = F_i u_ij - x_ij`, is penalised by the energy
+//! `Σ_i Σ_j c_ij |ε_ij|² / 2` with `c_ij = c_hg E v_i ŵ_ij / |u_ij|²` (N/m), `ŵ` the normalised
+//! kernel weight. `ε` is linear in the positions (through `F_i`), zero under any affine motion
+//! and rotation invariant in norm, so its exact gradient is a conservative force that conserves
+//! linear and angular momentum and never pumps energy into the zero-energy modes it removes.
 //!
 //! Damping: a dashpot along each pair, `β k_ij (v_ij·x̂_ij)`, with `k_ij = (λ + 2μ) v_i |d_ij|²`
 //! the pair's elastic stiffness (N/m): stiffness-proportional (Rayleigh β) damping that is
@@ -70,30 +73,63 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
     f
 }
 
-/// Update `q` towards the rotation that maximises `tr(Rᵀ f)` over proper rotations
-/// (Müller, Bender, Chentanez, Macklin 2016), at most `max_iterations` iterations.
+/// Set `q` to the rotation that maximises `tr(Rᵀ f)` over proper rotations.
+///
+/// Up to `newton_iterations` warm-started iterations on the objective of Müller, Bender,
+/// Chentanez and Macklin (2016), gradient `g = Σ_c r_c × f_c`, with Newton steps
+/// `δ = H⁻¹ g`, `H = tr(G) I - sym(G)`, `G = F Rᵀ` (quadratic convergence: 1–3 iterations from
+/// the previous step's rotation), until `|g| < 1e-12 |F|`. Where that does not converge (near a
+/// saddle of a strongly inverted `F`, where `H` is indefinite) the rotation is computed exactly
+/// from the SVD: `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
 #[inline]
-pub fn extract_rotation(f: &Mat3, q: &mut Quat, max_iterations: u32) {
-    for _ in 0..max_iterations {
-        let r = q.to_rotation_matrix();
-        let r = r.matrix();
-        let mut num = Vec3::zeros();
-        let mut den = 0.0;
+pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) {
+    let tolerance2 = 1.0e-24 * f.norm_squared().max(1.0e-30);
+    for _ in 0..newton_iterations {
+        let r = q.to_rotation_matrix().into_inner();
+        let mut g = Vec3::zeros();
         for c in 0..3 {
-            let rc = r.column(c);
-            let fc = f.column(c);
-            num += rc.cross(&fc);
-            den += rc.dot(&fc);
+            g += r.column(c).cross(&f.column(c));
         }
-        let omega = num / (den.abs() + 1.0e-9);
-        let w2 = omega.norm_squared();
-        if w2 < 1.0e-24 {
+        if g.norm_squared() < tolerance2 {
+            return;
+        }
+        let gm = f * r.transpose();
+        let h = Mat3::identity() * gm.trace() - (gm + gm.transpose()) * 0.5;
+        let Some(chol) = h.cholesky() else {
             break;
-        }
-        // A rotation by ~|ω| about ω: the normalised quaternion (1, ω/2); no trigonometry.
-        let dq = Quaternion::new(1.0, 0.5 * omega.x, 0.5 * omega.y, 0.5 * omega.z);
+        };
+        let delta = chol.solve(&g);
+        // A rotation by ~|δ| about δ: the normalised quaternion (1, δ/2); no trigonometry.
+        let dq = Quaternion::new(1.0, 0.5 * delta.x, 0.5 * delta.y, 0.5 * delta.z);
         *q = Quat::new_normalize(dq * q.into_inner());
     }
+    *q = rotation_from_svd(f);
+}
+
+/// The proper rotation maximising `tr(Rᵀ f)`, from the SVD of `f` (singular values sorted in
+/// decreasing order; the smallest one's direction flipped when `det(UVᵀ) < 0`).
+/// A non-finite `f` (which the step reports as divergence) gives the identity.
+pub fn rotation_from_svd(f: &Mat3) -> Quat {
+    if !f.iter().all(|c| c.is_finite()) {
+        return Quat::identity();
+    }
+    let Some(svd) = f.try_svd(true, true, Real::EPSILON, 200) else {
+        return Quat::identity();
+    };
+    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Quat::identity();
+    };
+    if (u * v_t).determinant() < 0.0 {
+        // nalgebra sorts singular values decreasingly: the last is the smallest.
+        let mut k = 0;
+        for c in 1..3 {
+            if svd.singular_values[c] < svd.singular_values[k] {
+                k = c;
+            }
+        }
+        u.column_mut(k).neg_mut();
+    }
+    Quat::from_matrix(&(u * v_t))
 }
 
 /// First Piola–Kirchhoff stress (Pa) of the corotated model for deformation gradient `f` and
@@ -104,7 +140,7 @@ pub fn corotated_stress(f: &Mat3, r: &Mat3, lambda: Real, mu: Real) -> Mat3 {
     (f - r) * (2.0 * mu) + r * (lambda * tr)
 }
 
-/// Scratch and output of [`accumulate_forces`] that the caller owns (no allocation inside).
+/// The inputs of [`accumulate_forces`].
 pub struct ForceInputs<'a> {
     /// Neighbourhoods of the body.
     pub nbr: &'a Neighbourhoods,
@@ -117,12 +153,15 @@ pub struct ForceInputs<'a> {
 }
 
 /// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
-/// `rotation` holds each particle's rotation, warm-started and updated in place.
+///
+/// `rotation` holds each particle's rotation, warm-started and updated in place; `scratch`
+/// must hold at least as many entries as the largest neighbourhood (no allocation inside).
 pub fn accumulate_forces(
     model: &ElasticModel,
     input: &ForceInputs<'_>,
     rotation: &mut [Quat],
     rotation_iterations: u32,
+    scratch: &mut [Vec3],
     force: &mut [Vec3],
 ) {
     let nbr = input.nbr;
@@ -134,26 +173,34 @@ pub fn accumulate_forces(
         extract_rotation(&f, &mut rotation[i], rotation_iterations);
         let r = rotation[i].to_rotation_matrix().into_inner();
         let vi = input.volume[i];
-        let p = corotated_stress(&f, &r, model.lambda, model.mu) * vi;
         let xi = x[i];
+        let range = nbr.range(i);
+        let first = range.start;
+        // Hourglass residuals ε_e = F u_e - x_ij and Q = Σ c_e ε_e u_eᵀ.
+        let c_scale = model.hourglass * vi;
+        let mut q = Mat3::zeros();
+        for e in range.clone() {
+            let j = nbr.index[e] as usize;
+            let u = nbr.rest_offset[e];
+            let eps = f * u - (x[j] - xi);
+            scratch[e - first] = eps;
+            q += eps * (u.transpose() * (c_scale * nbr.hourglass_weight[e]));
+        }
+        // Force on neighbour j: -(v_i P + Q) d_e + c_e ε_e; on i the opposite.
+        let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + q;
         let mut fi = Vec3::zeros();
-        for e in nbr.range(i) {
+        for e in range {
             let j = nbr.index[e] as usize;
             let d = nbr.gradient[e];
-            let u = nbr.rest_offset[e];
-            let xij = x[j] - xi;
-            let mut g = p * d;
-            let len2 = xij.norm_squared();
-            if len2 > 1.0e-30 {
-                // Central terms along x_ij, written without a square root:
-                // -c δ x̂ = -c ((F u - x)·x) x / |x|², and β k (v_ij·x̂) x̂ likewise.
-                let c_hg = model.hourglass * vi * nbr.hourglass_weight[e];
-                let mut central = -c_hg * (f * u - xij).dot(&xij);
-                if damped {
+            let mut g = m * d - scratch[e - first] * (c_scale * nbr.hourglass_weight[e]);
+            if damped {
+                let xij = x[j] - xi;
+                let len2 = xij.norm_squared();
+                if len2 > 1.0e-30 {
                     let k = pwave * vi * d.norm_squared();
-                    central += model.damping_stiffness * k * (input.v[j] - input.v[i]).dot(&xij);
+                    let rate = (input.v[j] - input.v[i]).dot(&xij);
+                    g += xij * (model.damping_stiffness * k * rate / len2);
                 }
-                g += xij * (central / len2);
             }
             fi += g;
             force[j] -= g;

@@ -78,7 +78,10 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         (hi - lo).max() * 1e3
     );
     std::fs::create_dir_all(&args.out)?;
-    println!("{:>8} {:>12} {:>12} {:>10}", "t (s)", "max |u| (mm)", "volume ratio", "ms/step");
+    println!(
+        "{:>8} {:>12} {:>12} {:>10}",
+        "t (s)", "max |u| (mm)", "volume ratio", "ms/step"
+    );
     let mut elapsed = 0.0;
     for s in 1..=args.steps {
         let t0 = Instant::now();
@@ -105,7 +108,10 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 b.positions(),
                 b.tets(),
                 &[],
-                &[("displacement", &displacement), ("velocity", b.velocities())],
+                &[
+                    ("displacement", &displacement),
+                    ("velocity", b.velocities()),
+                ],
             )?;
         }
     }

@@ -201,7 +201,9 @@ impl PointGrid {
         let ext = hi - lo;
         let vol = (ext.x.max(1e-12)) * (ext.y.max(1e-12)) * (ext.z.max(1e-12));
         // About two points per cell.
-        let cell = (2.0 * vol / points.len() as Real).cbrt().max(ext.max() * 1e-6);
+        let cell = (2.0 * vol / points.len() as Real)
+            .cbrt()
+            .max(ext.max() * 1e-6);
         let dims = [0, 1, 2].map(|a| ((ext[a] / cell) as usize + 1).min(1 << 10));
         let mut grid = PointGrid {
             origin: lo,

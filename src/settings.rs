@@ -50,8 +50,16 @@ pub struct Settings {
     pub hourglass_stiffness: Real,
     /// Enable the XPBD per-tetrahedron volume constraints (eq. 13 of the paper).
     pub volume_constraints: bool,
-    /// Volume compliance (1/Pa): the inverse of the bulk modulus the constraints add;
-    /// 0 makes every tetrahedron's volume a hard constraint.
+    /// With volume constraints on: move the volumetric (λ) part of the material from the
+    /// particle stress into the tetrahedron volume constraints, whose compliance becomes `1/λ`
+    /// (plus [`Settings::volume_compliance`]). The linear response is the material's, the stiff
+    /// volumetric term of nearly incompressible tissue is handled implicitly by XPBD instead of
+    /// limiting the explicit step, and the constraints never fight the particle stress.
+    /// `false` gives the paper's arrangement: full corotated stress on the particles plus
+    /// volume constraints of compliance `volume_compliance` (0 = hard).
+    pub volumetric_split: bool,
+    /// Additional compliance (1/Pa) of the volume constraints: the inverse of the bulk modulus
+    /// they add on their own; 0 adds nothing with the split and makes them hard without it.
     pub volume_compliance: Real,
     /// Gauss–Seidel iterations over all constraints per substep.
     pub iterations: u32,
@@ -74,6 +82,7 @@ impl Default for Settings {
             damping_stiffness: 0.0,
             hourglass_stiffness: 0.05,
             volume_constraints: true,
+            volumetric_split: true,
             volume_compliance: 0.0,
             iterations: 1,
             contact_mode: ContactMode::ExactShape,

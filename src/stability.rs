@@ -17,7 +17,11 @@ const SAFETY: Real = 1.05;
 pub fn max_angular_frequency(body: &Body) -> Real {
     let n = body.particle_count();
     let rest = body.rest_positions();
-    let inv_sqrt_m: Vec<Real> = body.inertial_masses().iter().map(|m| 1.0 / m.sqrt()).collect();
+    let inv_sqrt_m: Vec<Real> = body
+        .inertial_masses()
+        .iter()
+        .map(|m| 1.0 / m.sqrt())
+        .collect();
     // Deterministic start vector with energy in every particle and direction.
     let mut y: Vec<Vec3> = (0..n)
         .map(|i| {

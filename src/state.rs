@@ -65,12 +65,20 @@ struct Reader<'a> {
 
 impl Reader<'_> {
     fn u32(&mut self) -> u32 {
-        let v = u32::from_le_bytes(self.bytes[self.at..self.at + 4].try_into().unwrap_or([0; 4]));
+        let v = u32::from_le_bytes(
+            self.bytes[self.at..self.at + 4]
+                .try_into()
+                .unwrap_or([0; 4]),
+        );
         self.at += 4;
         v
     }
     fn f64(&mut self) -> Real {
-        let v = f64::from_le_bytes(self.bytes[self.at..self.at + 8].try_into().unwrap_or([0; 8]));
+        let v = f64::from_le_bytes(
+            self.bytes[self.at..self.at + 8]
+                .try_into()
+                .unwrap_or([0; 8]),
+        );
         self.at += 8;
         v
     }

@@ -87,6 +87,9 @@ impl World {
         settings.validate()?;
         let s = &self.settings;
         let bodies_affected = settings.hourglass_stiffness != s.hourglass_stiffness
+            || settings.volume_constraints != s.volume_constraints
+            || settings.volumetric_split != s.volumetric_split
+            || settings.volume_compliance != s.volume_compliance
             || settings.damping_stiffness != s.damping_stiffness
             || settings.mass_scaling != s.mass_scaling
             || settings.dt != s.dt
@@ -130,6 +133,41 @@ impl World {
         self.bodies
             .get_mut(id.0 as usize)
             .ok_or(Error::UnknownBody(id.0))
+    }
+    /// Set the positions (m) and velocities (m/s) of every particle of a body, e.g. an initial
+    /// condition. Both slices must have one entry per particle and be finite; fixed particles
+    /// take the given position and zero velocity. Nothing changes on error.
+    pub fn set_body_state(
+        &mut self,
+        id: BodyId,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+    ) -> Result<(), Error> {
+        let body = self.body_mut(id)?;
+        let n = body.particle_count();
+        if positions.len() != n || velocities.len() != n {
+            return Err(Error::InvalidArgument(format!(
+                "set_body_state needs {n} positions and {n} velocities, got {} and {}",
+                positions.len(),
+                velocities.len()
+            )));
+        }
+        if positions
+            .iter()
+            .chain(velocities)
+            .any(|v| !is_finite_vec(v))
+        {
+            return Err(Error::NonFinite("particle state".into()));
+        }
+        body.x.copy_from_slice(positions);
+        for i in 0..n {
+            body.v[i] = if body.fixed[i] {
+                Vec3::zeros()
+            } else {
+                velocities[i]
+            };
+        }
+        Ok(())
     }
     /// Fix the particles with the given indices (they keep their current position). Nothing is
     /// fixed if any index is out of range.
@@ -186,7 +224,9 @@ impl World {
     }
     /// A tool by id.
     pub fn tool(&self, id: ToolId) -> Result<&Tool, Error> {
-        self.tools.get(id.0 as usize).ok_or(Error::UnknownTool(id.0))
+        self.tools
+            .get(id.0 as usize)
+            .ok_or(Error::UnknownTool(id.0))
     }
     /// Set the pose a tool reaches at the end of the next step (interpolated across substeps).
     /// A NaN/Inf or non-unit pose is rejected and nothing changes.
@@ -241,10 +281,14 @@ impl World {
         Ok(())
     }
 
-    /// Substeps a step needs for stability, and whether `max_substeps` clamped that number.
+    /// Substeps the next step needs, and whether `max_substeps` clamped that number: enough
+    /// for the explicit stability limit of the stiffest body, and enough that no tool moves
+    /// (translation plus rotation at its bounding radius) more than one particle radius per
+    /// substep, so that a large pose jump is swept rather than teleported.
     pub fn substeps_needed(&self) -> (u32, bool) {
         let s = &self.settings;
         let mut h_max = Real::INFINITY;
+        let mut radius = Real::INFINITY;
         for b in &self.bodies {
             let w = b.omega_max;
             if w > 0.0 {
@@ -252,9 +296,18 @@ impl World {
                 let xi = 0.5 * s.damping_stiffness * w;
                 h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
             }
+            radius = radius.min(b.particle_radius);
         }
-        let needed = (s.dt / (s.stability_margin * h_max)).ceil();
-        let needed = if needed.is_finite() { needed as u32 } else { 1 };
+        let stable = (s.dt / (s.stability_margin * h_max)).ceil();
+        let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
+        for t in &self.tools {
+            let travel = (t.target.position - t.pose.position).norm()
+                + t.pose.orientation.angle_to(&t.target.orientation) * t.bounding_radius;
+            let sweep = (travel / radius).ceil();
+            if sweep.is_finite() {
+                needed = needed.max(sweep.min(u32::MAX as Real) as u32);
+            }
+        }
         let n = needed.max(s.min_substeps);
         if n > s.max_substeps {
             (s.max_substeps, true)
@@ -348,9 +401,8 @@ impl World {
         let s_cur = k as Real / n as Real;
         for it in 0..self.settings.iterations {
             if self.settings.volume_constraints {
-                let compliance = self.settings.volume_compliance;
                 for body in &mut self.bodies {
-                    project_volumes(body, compliance / (h * h));
+                    project_volumes(body, h);
                 }
             }
             if organ_contact {
@@ -435,6 +487,7 @@ fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real) {
         &input,
         &mut body.rotation,
         ROTATION_ITERATIONS,
+        &mut body.pair_scratch,
         &mut body.force,
     );
     for i in 0..body.x.len() {
@@ -450,9 +503,14 @@ fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real) {
     body.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
 }
 
-/// One Gauss–Seidel pass over a body's tetrahedron volume constraints; `compliance_per_h2` is
-/// the volume compliance (1/Pa) divided by h² (s²).
-fn project_volumes(body: &mut Body, compliance_per_h2: Real) {
+/// One Gauss–Seidel pass over a body's tetrahedron volume constraints for a substep `h` (s).
+/// Each constraint's XPBD compliance is the body's compliance per unit volume (1/Pa) times the
+/// tetrahedron's rest volume (m³), divided by h².
+fn project_volumes(body: &mut Body, h: Real) {
+    if !body.volume_compliance.is_finite() {
+        return;
+    }
+    let compliance_per_h2 = body.volume_compliance / (h * h);
     for t in 0..body.tets.len() {
         let v0 = body.tet_rest_volume[t];
         project_volume_tet(
@@ -504,11 +562,10 @@ fn project_tool_contacts(
         match mode {
             ContactMode::ExactShape => {
                 let proj = tool.shape.project_point(&iso, &Point::from(p), false);
-                let fallback = (p - centre)
-                    .try_normalize(1e-12)
-                    .unwrap_or_else(Vec3::y);
+                let fallback = (p - centre).try_normalize(1e-12).unwrap_or_else(Vec3::y);
                 let surface = proj.point.coords;
-                if let Some(c) = project_point_surface(&mut p, &surface, proj.is_inside, r, &fallback)
+                if let Some(c) =
+                    project_point_surface(&mut p, &surface, proj.is_inside, r, &fallback)
                 {
                     apply(&mut p, c, surface, tool);
                 }

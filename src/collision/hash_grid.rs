@@ -123,7 +123,10 @@ mod tests {
                 Vec3::new((t * 0.37).sin(), (t * 0.73).cos(), (t * 0.11).sin() * 0.5)
             })
             .collect();
-        let b: Vec<Vec3> = a.iter().map(|p| p * 0.9 + Vec3::new(0.05, 0.0, 0.0)).collect();
+        let b: Vec<Vec3> = a
+            .iter()
+            .map(|p| p * 0.9 + Vec3::new(0.05, 0.0, 0.0))
+            .collect();
         let mut grid = HashGrid::default();
         grid.reserve(a.len() + b.len());
         let r = 0.1;

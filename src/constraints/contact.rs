@@ -46,7 +46,11 @@ pub fn project_point_surface(
 /// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m): the
 /// paper's point–point contact with a tool sample.
 #[inline]
-pub fn project_point_sphere(p: &mut Vec3, centre: &Vec3, radius: Real) -> Option<ContactProjection> {
+pub fn project_point_sphere(
+    p: &mut Vec3,
+    centre: &Vec3,
+    radius: Real,
+) -> Option<ContactProjection> {
     let offset = *p - centre;
     let d2 = offset.norm_squared();
     if d2 >= radius * radius {
@@ -101,8 +105,10 @@ mod tests {
     #[test]
     fn point_outside_beyond_radius_is_untouched_and_inside_is_pushed_out() {
         let mut p = Vec3::new(0.0, 2.0, 0.0);
-        assert!(project_point_surface(&mut p, &Vec3::new(0.0, 1.0, 0.0), false, 0.5, &Vec3::y())
-            .is_none());
+        assert!(
+            project_point_surface(&mut p, &Vec3::new(0.0, 1.0, 0.0), false, 0.5, &Vec3::y())
+                .is_none()
+        );
         let mut q = Vec3::new(0.0, 0.8, 0.0);
         let c = project_point_surface(&mut q, &Vec3::new(0.0, 1.0, 0.0), true, 0.5, &Vec3::y())
             .unwrap();

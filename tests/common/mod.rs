@@ -1,0 +1,116 @@
+//! Helpers shared by the integration tests: mesh paths, scene builders, rigid alignment.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use tissuesim::mesh::{self, TetMesh};
+use tissuesim::{BodyId, BodyOptions, Material, Real, Settings, Vec3, World};
+
+/// A mesh from the shared folder beside the repository.
+pub fn shared_mesh(file: &str) -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(file)
+}
+
+/// A shared liver mesh scaled by 0.03 (about 0.2 m across).
+pub fn liver(file: &str) -> TetMesh {
+    mesh::load(&shared_mesh(file), 0.03)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0
+}
+
+/// The DESIGN §7 material: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.
+pub fn tissue() -> BodyOptions {
+    BodyOptions {
+        material: Material {
+            youngs_modulus: 5.0e3,
+            poisson_ratio: 0.45,
+            density: 1060.0,
+        },
+        ..BodyOptions::default()
+    }
+}
+
+/// Fix every particle in the top `fraction` of the body's y range; returns how many.
+pub fn fix_top(world: &mut World, body: BodyId, fraction: Real) -> usize {
+    let b = world.body(body).unwrap();
+    let (mut lo, mut hi) = (Vec3::repeat(Real::MAX), Vec3::repeat(Real::MIN));
+    for p in b.positions() {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let y = hi.y - fraction * (hi.y - lo.y);
+    world
+        .fix_box(
+            body,
+            Vec3::new(lo.x - 1.0, y, lo.z - 1.0),
+            Vec3::new(hi.x + 1.0, hi.y + 1.0, hi.z + 1.0),
+        )
+        .unwrap()
+}
+
+/// Settings without gravity.
+pub fn weightless() -> Settings {
+    Settings {
+        gravity: Vec3::zeros(),
+        ..Settings::default()
+    }
+}
+
+/// Axis-aligned bounding box (min, max) of points.
+pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+    let mut lo = points[0];
+    let mut hi = points[0];
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (lo, hi)
+}
+
+/// Largest distance between `x` and the rigid motion of `rest` that best fits it (Kabsch,
+/// weights `w`): the deformation left once translation and rotation are removed (m).
+pub fn max_residual_after_rigid_fit(rest: &[Vec3], x: &[Vec3], w: &[Real]) -> Real {
+    let wsum: Real = w.iter().sum();
+    let c0: Vec3 = rest.iter().zip(w).map(|(p, m)| p * *m).sum::<Vec3>() / wsum;
+    let c1: Vec3 = x.iter().zip(w).map(|(p, m)| p * *m).sum::<Vec3>() / wsum;
+    let mut h = tissuesim::Mat3::zeros();
+    for ((p, q), m) in rest.iter().zip(x).zip(w) {
+        h += (q - c1) * (p - c0).transpose() * *m;
+    }
+    let svd = h.svd(true, true);
+    let (u, vt) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let mut d = tissuesim::Mat3::identity();
+    d[(2, 2)] = (u * vt).determinant().signum();
+    let r = u * d * vt;
+    rest.iter()
+        .zip(x)
+        .map(|(p, q)| (r * (p - c0) + c1 - q).norm())
+        .fold(0.0, Real::max)
+}
+
+/// Signed volumes of every tetrahedron at positions `x` (m³).
+pub fn tet_volumes(x: &[Vec3], tets: &[[u32; 4]]) -> Vec<Real> {
+    tets.iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|k| x[k as usize]);
+            (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
+        })
+        .collect()
+}
+
+/// A deterministic pseudo-random sequence in [-1, 1] (xorshift), for perturbations.
+pub struct Noise(u64);
+
+impl Noise {
+    pub fn new(seed: u64) -> Self {
+        Noise(seed.max(1))
+    }
+    pub fn next(&mut self) -> Real {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+    }
+    pub fn vec(&mut self) -> Vec3 {
+        Vec3::new(self.next(), self.next(), self.next())
+    }
+}

@@ -1,0 +1,61 @@
+//! Inversion recovery: liver_1k6 flattened onto a plane, or mirrored (every tetrahedron
+//! inverted), returns to its rest shape within 2 s simulated.
+
+mod common;
+
+use common::{bounds, liver, max_residual_after_rigid_fit, tet_volumes, tissue};
+use tissuesim::{Settings, Vec3, World};
+
+fn recover(deform: impl Fn(&Vec3, &Vec3) -> Vec3, what: &str) {
+    let settings = Settings {
+        gravity: Vec3::zeros(),
+        damping_mass: 10.0,
+        ..Settings::default()
+    };
+    let mut world = World::new(settings).unwrap();
+    let id = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
+    let b = world.body(id).unwrap();
+    let rest = b.rest_positions().to_vec();
+    let (lo, hi) = bounds(&rest);
+    let centre = (lo + hi) * 0.5;
+    let size = (hi - lo).max();
+    let start: Vec<Vec3> = rest.iter().map(|p| deform(p, &centre)).collect();
+    let tets = b.tets().to_vec();
+    let positive_at_start = tet_volumes(&start, &tets)
+        .iter()
+        .filter(|v| **v > 0.0)
+        .count();
+    let zero = vec![Vec3::zeros(); rest.len()];
+    world.set_body_state(id, &start, &zero).unwrap();
+    assert!(
+        positive_at_start < tets.len() / 100,
+        "{what}: the start state must have (nearly) no positive tetrahedron"
+    );
+    for _ in 0..2000 {
+        world.step().unwrap();
+    }
+    let b = world.body(id).unwrap();
+    let negative = tet_volumes(b.positions(), b.tets())
+        .iter()
+        .filter(|v| **v <= 0.0)
+        .count();
+    assert_eq!(
+        negative, 0,
+        "{what}: {negative} tetrahedra still inverted after 2 s"
+    );
+    let residual = max_residual_after_rigid_fit(&rest, b.positions(), b.masses());
+    assert!(
+        residual < 0.01 * size,
+        "{what}: shape error {residual} m after 2 s, size {size} m"
+    );
+}
+
+#[test]
+fn recovers_from_being_flattened_onto_a_plane() {
+    recover(|p, c| Vec3::new(p.x, c.y, p.z), "flattened");
+}
+
+#[test]
+fn recovers_from_being_mirrored() {
+    recover(|p, c| Vec3::new(p.x, 2.0 * c.y - p.y, p.z), "mirrored");
+}
