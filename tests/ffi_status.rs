@@ -1423,10 +1423,7 @@ fn outputs_are_sane() {
     let mut dv = 1;
     assert_eq!(unsafe { ts_world_diverged_steps(w, &mut dv) }, S::Ok);
     assert_eq!(dv, 0);
-    let mut fixed = vec![0u32; 4];
-    for (i, f) in fixed.iter_mut().enumerate() {
-        *f = i as u32;
-    }
+    let fixed = [0u32, 1, 2, 3];
     assert_eq!(
         unsafe { ts_body_fix_particles(w, 0, fixed.as_ptr(), 4) },
         S::Ok
