@@ -392,18 +392,21 @@ int main(void) {
         CHECK(memcmp(&got, &above, sizeof got) == 0);
     }
 
-    /* ---- stepping: press the sphere into the lattice ---- */
+    /* ---- stepping: press the sphere gently into the lattice (0.1 m/s, 30 steps, from 0.5 mm
+     * above the top face to 2.5 mm into it), then hold it there for TS_STEPS steps ---- */
     ts_step_report report = {0, 0};
-    for (long s = 0; s < steps; s++) {
+    const long press = 30;
+    for (long s = 0; s < press + steps; s++) {
         ts_pose p = above;
-        p.position[1] -= 0.006 * (double)(s + 1) / (double)steps;
+        long k = s < press ? s + 1 : press;
+        p.position[1] = CELLS * h + 0.01 + 0.0005 - 1e-4 * (double)k;
         CHECK_OK(ts_tool_set_pose(world, sphere, &p));
         CHECK_OK(ts_world_step(world, &report));
     }
     CHECK(report.substeps >= 1);
     double t = 0;
     CHECK_OK(ts_world_time(world, &t));
-    CHECK(fabs(t - (double)steps * settings.dt) < 1e-12);
+    CHECK(fabs(t - (double)(press + steps) * settings.dt) < 1e-12);
     uint64_t diverged = 99;
     CHECK_OK(ts_world_diverged_steps(world, &diverged));
     CHECK(diverged == 0);
