@@ -19,6 +19,19 @@ pub struct Material {
     pub density: Real,
 }
 
+impl Material {
+    /// First Lamé parameter λ = Eν / ((1 + ν)(1 - 2ν)) (Pa): under the volumetric split the
+    /// volume constraints get compliance `1/λ`.
+    pub fn lame_lambda(&self) -> Real {
+        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    }
+    /// Shear modulus μ = E / (2(1 + ν)) (Pa).
+    pub fn shear_modulus(&self) -> Real {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+}
+
 impl Default for Material {
     /// Liver-like soft tissue: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.
     fn default() -> Self {
@@ -97,7 +110,8 @@ pub struct Body {
     pub(crate) boundary: Vec<[u32; 3]>,
     pub(crate) particle_radius: Real,
     pub(crate) rest_volume: Real,
-    /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ disables them.
+    /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
+    /// split) disables them.
     pub(crate) volume_compliance: Real,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,

@@ -50,16 +50,18 @@ pub struct Settings {
     pub hourglass_stiffness: Real,
     /// Enable the XPBD per-tetrahedron volume constraints (eq. 13 of the paper).
     pub volume_constraints: bool,
-    /// With volume constraints on: move the volumetric (λ) part of the material from the
-    /// particle stress into the tetrahedron volume constraints, whose compliance becomes `1/λ`
-    /// (plus [`Settings::volume_compliance`]). The linear response is the material's, the stiff
-    /// volumetric term of nearly incompressible tissue is handled implicitly by XPBD instead of
-    /// limiting the explicit step, and the constraints never fight the particle stress.
-    /// `false` gives the paper's arrangement: full corotated stress on the particles plus
-    /// volume constraints of compliance `volume_compliance` (0 = hard).
+    /// With volume constraints on: the volumetric (λ) term leaves the particle stress and the
+    /// tetrahedron volume constraints carry it, with compliance `1/λ` per unit volume (plus
+    /// [`Settings::volume_compliance`]). The particles keep the shear part `2μ (F - R)`. The
+    /// linear response is the material's own; the stiff volumetric response of nearly
+    /// incompressible tissue (ν → 0.5) is handled implicitly by XPBD instead of limiting the
+    /// explicit step; constraints and stress never fight each other. `false` gives the paper's
+    /// literal arrangement: the full corotated stress on the particles plus volume constraints
+    /// of compliance `volume_compliance` on top (0 = hard, which over-constrains a tetrahedral
+    /// mesh: more tetrahedra than degrees of freedom).
     pub volumetric_split: bool,
-    /// Additional compliance (1/Pa) of the volume constraints: the inverse of the bulk modulus
-    /// they add on their own; 0 adds nothing with the split and makes them hard without it.
+    /// Compliance (1/Pa, per unit volume) the volume constraints get in addition to `1/λ`
+    /// under the split, or in total without it (0 = hard constraints).
     pub volume_compliance: Real,
     /// Gauss–Seidel iterations over all constraints per substep.
     pub iterations: u32,

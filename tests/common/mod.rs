@@ -10,11 +10,18 @@ pub fn shared_mesh(file: &str) -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(file)
 }
 
-/// A shared liver mesh scaled by 0.03 (about 0.2 m across).
+/// A shared liver mesh scaled by 0.03 (about 0.19 × 0.15 × 0.13 m) and translated so that its
+/// bounding box is centred on the origin.
 pub fn liver(file: &str) -> TetMesh {
-    mesh::load(&shared_mesh(file), 0.03)
+    let mut mesh = mesh::load(&shared_mesh(file), 0.03)
         .unwrap_or_else(|e| panic!("{e}"))
-        .0
+        .0;
+    let (lo, hi) = mesh.bounding_box();
+    let centre = (lo + hi) * 0.5;
+    for p in &mut mesh.nodes {
+        *p -= centre;
+    }
+    mesh
 }
 
 /// The DESIGN §7 material: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.

@@ -1,0 +1,96 @@
+//! No heap allocation inside a step after the first: two bodies in organ–organ contact, a probe
+//! with friction pressing one of them, in both contact modes.
+
+mod common;
+
+use common::{fix_top, liver, tissue};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use tissuesim::mesh::default_organ;
+use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3, World};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if COUNTING.with(|c| c.get()) {
+            ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        }
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if COUNTING.with(|c| c.get()) {
+            ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        }
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_during(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    COUNTING.with(|c| c.set(true));
+    f();
+    COUNTING.with(|c| c.set(false));
+    ALLOCATIONS.load(Ordering::SeqCst) - before
+}
+
+#[test]
+fn steps_after_the_first_do_not_allocate() {
+    for mode in [ContactMode::ExactShape, ContactMode::SampledPoints] {
+        let settings = Settings {
+            contact_mode: mode,
+            ..Settings::default()
+        };
+        let mut world = World::new(settings).unwrap();
+        let a = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
+        fix_top(&mut world, a, 0.1);
+        let mut organ = default_organ();
+        for p in &mut organ.nodes {
+            *p += Vec3::new(0.0, -0.13, 0.0);
+        }
+        let b = world.add_body(&organ, &tissue()).unwrap();
+        world.set_body_pair_friction(a, b, 0.3, 0.2).unwrap();
+        let options = ToolOptions {
+            friction_static: 0.5,
+            friction_kinetic: 0.4,
+            ..ToolOptions::default()
+        };
+        let tool = world
+            .add_tool(
+                ToolShape::Capsule {
+                    half_height: 0.02,
+                    radius: 0.008,
+                },
+                Pose::at(Vec3::new(0.0, 0.0, 0.1)),
+                &options,
+            )
+            .unwrap();
+        world.step().unwrap();
+        let n = allocations_during(|| {
+            for k in 0..100 {
+                let z = 0.1 - 0.0005 * k as f64;
+                world
+                    .set_tool_pose(tool, Pose::at(Vec3::new(0.0, -0.02, z)))
+                    .unwrap();
+                world.step().unwrap();
+            }
+        });
+        assert!(
+            world.tool(tool).unwrap().wrench().contact_count > 0,
+            "{mode:?}: no contact"
+        );
+        assert_eq!(n, 0, "{mode:?}: {n} allocations in 100 steps");
+    }
+}
