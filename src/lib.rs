@@ -41,6 +41,6 @@ pub mod world;
 pub use body::{Body, BodyOptions, Material};
 pub use collision::tool::{Pose, Tool, ToolOptions, ToolShape, Wrench};
 pub use error::Error;
-pub use math::{Mat3, Real, Vec3};
+pub use math::{Mat3, Quat, Real, Vec3};
 pub use settings::{ContactMode, Settings};
 pub use world::{BodyId, StepReport, ToolId, World};

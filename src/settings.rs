@@ -67,6 +67,12 @@ pub struct Settings {
     pub iterations: u32,
     /// How tool–tissue contact is detected.
     pub contact_mode: ContactMode,
+    /// Largest speed (m/s) at which a tool contact pushes a particle out of the tool: a
+    /// substep moves a particle by at most `max_depenetration_speed · h` along the contact
+    /// normal, so a tool that jumps into the tissue (a haptic glitch) is left by the particles
+    /// gently over the following steps instead of flinging them out (PhysX's
+    /// `maxDepenetrationVelocity`). Normal probing is far slower than the default.
+    pub max_depenetration_speed: Real,
     /// Enable contact between particles of the same body (off by default).
     pub self_contact: bool,
 }
@@ -88,6 +94,7 @@ impl Default for Settings {
             volume_compliance: 0.0,
             iterations: 1,
             contact_mode: ContactMode::ExactShape,
+            max_depenetration_speed: 1.0,
             self_contact: false,
         }
     }
@@ -121,6 +128,9 @@ impl Settings {
                     "{name} must be finite and >= 0"
                 )));
             }
+        }
+        if !(self.max_depenetration_speed.is_finite() && self.max_depenetration_speed > 0.0) {
+            return bad("max_depenetration_speed must be finite and > 0 m/s");
         }
         if self.iterations == 0 {
             return bad("iterations must be >= 1");

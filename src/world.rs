@@ -409,11 +409,13 @@ impl World {
                 self.project_organ_contacts();
             }
             let mode = self.settings.contact_mode;
+            let max_correction = self.settings.max_depenetration_speed * h;
             for tool in &mut self.tools {
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 for body in &mut self.bodies {
-                    project_tool_contacts(tool, body, &prev, &cur, mode, it == 0);
+                    let motion = (&prev, &cur);
+                    project_tool_contacts(tool, body, motion, mode, max_correction, it == 0);
                 }
             }
         }
@@ -524,14 +526,15 @@ fn project_volumes(body: &mut Body, h: Real) {
     }
 }
 
-/// Project the contacts between `tool` (moving from `prev` to `cur` over this substep) and the
-/// particles of `body`, with friction, and accumulate the tool's impulse and moment.
+/// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this
+/// substep) and the particles of `body`, with friction, each normal correction at most
+/// `max_correction` (m), and accumulate the tool's impulse and moment.
 fn project_tool_contacts(
     tool: &mut Tool,
     body: &mut Body,
-    prev: &Pose,
-    cur: &Pose,
+    (prev, cur): (&Pose, &Pose),
     mode: ContactMode,
+    max_correction: Real,
     count: bool,
 ) {
     let iso = cur.isometry();
@@ -555,7 +558,7 @@ fn project_tool_contacts(
         let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
             let tool_motion = contact - back.transform_point(&Point::from(contact)).coords;
             let rel = (*p - body.x[i]) - tool_motion;
-            *p += friction_correction(&rel, &c.normal, c.depth, mu_s, mu_k);
+            *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
             tool.acc_penetration = tool.acc_penetration.max(c.depth);
             touched = Some(contact);
         };
@@ -564,8 +567,9 @@ fn project_tool_contacts(
                 let proj = tool.shape.project_point(&iso, &Point::from(p), false);
                 let fallback = (p - centre).try_normalize(1e-12).unwrap_or_else(Vec3::y);
                 let surface = proj.point.coords;
+                let inside = proj.is_inside;
                 if let Some(c) =
-                    project_point_surface(&mut p, &surface, proj.is_inside, r, &fallback)
+                    project_point_surface(&mut p, &surface, inside, r, &fallback, max_correction)
                 {
                     apply(&mut p, c, surface, tool);
                 }
@@ -574,7 +578,7 @@ fn project_tool_contacts(
                 let rs = tool.sample_radius;
                 for s in 0..tool.samples.len() {
                     let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
-                    if let Some(c) = project_point_sphere(&mut p, &sw, r + rs) {
+                    if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, max_correction) {
                         let contact = sw + c.normal * rs;
                         apply(&mut p, c, contact, tool);
                     }

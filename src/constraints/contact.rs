@@ -9,12 +9,16 @@ pub struct ContactProjection {
     pub normal: Vec3,
     /// Depth of the violation before the projection, `-C` (m, > 0).
     pub depth: Real,
+    /// Length of the correction applied along the normal (m): the depth, or less when
+    /// limited by `max_correction`.
+    pub correction: Real,
 }
 
-/// Push a particle at `p` out of a half-space-like obstacle: the particle must be at least `r`
-/// (m) from the obstacle surface, whose closest point is `surface` (m) with the particle inside
-/// the obstacle when `inside`. `fallback_normal` is used when `p` lies on the surface.
-/// Returns the projection when the constraint was violated (and moves `p`).
+/// Push a particle at `p` out of an obstacle: the particle must be at least `r` (m) from the
+/// obstacle surface, whose closest point is `surface` (m), the particle being inside the
+/// obstacle when `inside`. `fallback_normal` is used when `p` lies on the surface. The
+/// correction is at most `max_correction` (m). Returns the projection when the constraint was
+/// violated (and moves `p`).
 #[inline]
 pub fn project_point_surface(
     p: &mut Vec3,
@@ -22,6 +26,7 @@ pub fn project_point_surface(
     inside: bool,
     r: Real,
     fallback_normal: &Vec3,
+    max_correction: Real,
 ) -> Option<ContactProjection> {
     let offset = *p - surface;
     let dist = offset.norm();
@@ -39,17 +44,23 @@ pub fn project_point_surface(
     if c >= 0.0 {
         return None;
     }
-    *p -= normal * c;
-    Some(ContactProjection { normal, depth: -c })
+    let correction = (-c).min(max_correction);
+    *p += normal * correction;
+    Some(ContactProjection {
+        normal,
+        depth: -c,
+        correction,
+    })
 }
 
-/// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m): the
-/// paper's point–point contact with a tool sample.
+/// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m), by at
+/// most `max_correction` (m): the paper's point–point contact with a tool sample.
 #[inline]
 pub fn project_point_sphere(
     p: &mut Vec3,
     centre: &Vec3,
     radius: Real,
+    max_correction: Real,
 ) -> Option<ContactProjection> {
     let offset = *p - centre;
     let d2 = offset.norm_squared();
@@ -59,8 +70,13 @@ pub fn project_point_sphere(
     let d = d2.sqrt();
     let normal = if d > 1e-12 { offset / d } else { Vec3::y() };
     let depth = radius - d;
-    *p += normal * depth;
-    Some(ContactProjection { normal, depth })
+    let correction = depth.min(max_correction);
+    *p += normal * correction;
+    Some(ContactProjection {
+        normal,
+        depth,
+        correction,
+    })
 }
 
 /// Separate two particles (inverse masses `wa`, `wb` in 1/kg) to at least `distance` (m)
@@ -84,7 +100,11 @@ pub fn project_particle_particle(
     let depth = distance - d;
     *pa += normal * (depth * wa / wsum);
     *pb -= normal * (depth * wb / wsum);
-    Some(ContactProjection { normal, depth })
+    Some(ContactProjection {
+        normal,
+        depth,
+        correction: depth,
+    })
 }
 
 #[cfg(test)]
@@ -105,14 +125,16 @@ mod tests {
     #[test]
     fn point_outside_beyond_radius_is_untouched_and_inside_is_pushed_out() {
         let mut p = Vec3::new(0.0, 2.0, 0.0);
-        assert!(
-            project_point_surface(&mut p, &Vec3::new(0.0, 1.0, 0.0), false, 0.5, &Vec3::y())
-                .is_none()
-        );
+        let surface = Vec3::new(0.0, 1.0, 0.0);
+        assert!(project_point_surface(&mut p, &surface, false, 0.5, &Vec3::y(), 1.0).is_none());
         let mut q = Vec3::new(0.0, 0.8, 0.0);
-        let c = project_point_surface(&mut q, &Vec3::new(0.0, 1.0, 0.0), true, 0.5, &Vec3::y())
-            .unwrap();
+        let c = project_point_surface(&mut q, &surface, true, 0.5, &Vec3::y(), 1.0).unwrap();
         assert!((q - Vec3::new(0.0, 1.5, 0.0)).norm() < 1e-12);
         assert!((c.depth - 0.7).abs() < 1e-12);
+        // A limited correction moves by max_correction only and reports the full depth.
+        let mut s = Vec3::new(0.0, 0.8, 0.0);
+        let c = project_point_surface(&mut s, &surface, true, 0.5, &Vec3::y(), 0.1).unwrap();
+        assert!((s - Vec3::new(0.0, 0.9, 0.0)).norm() < 1e-12);
+        assert!((c.correction - 0.1).abs() < 1e-12 && (c.depth - 0.7).abs() < 1e-12);
     }
 }
