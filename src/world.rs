@@ -160,12 +160,8 @@ impl World {
             return Err(Error::NonFinite("particle state".into()));
         }
         body.x.copy_from_slice(positions);
-        for i in 0..n {
-            body.v[i] = if body.fixed[i] {
-                Vec3::zeros()
-            } else {
-                velocities[i]
-            };
+        for ((v, given), fixed) in body.v.iter_mut().zip(velocities).zip(&body.fixed) {
+            *v = if *fixed { Vec3::zeros() } else { *given };
         }
         Ok(())
     }

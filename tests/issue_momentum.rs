@@ -11,10 +11,10 @@ fn momenta(world: &World, id: tissuesim::BodyId) -> (Vec3, Vec3) {
     let m = b.inertial_masses();
     let mut p = Vec3::zeros();
     let mut l = Vec3::zeros();
-    for i in 0..b.particle_count() {
-        let mv = b.velocities()[i] * m[i];
+    for ((x, v), mi) in b.positions().iter().zip(b.velocities()).zip(m) {
+        let mv = v * *mi;
         p += mv;
-        l += b.positions()[i].cross(&mv);
+        l += x.cross(&mv);
     }
     (p, l)
 }

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The whole test suite: formatting, lints, Rust tests (solver, mesh I/O, C ABI from Rust),
+# the C programs (built, run, and run under valgrind), and the FMU (built, validated and
+# simulated by fmpy in a virtual environment this script creates).
+#
+#   scripts/test_all.sh
+#
+# Needs only what a fresh Debian machine with the Rust toolchain, a C compiler and Python 3
+# has; installs valgrind and python3-venv with apt-get if they are missing, and fmpy from PyPI
+# into build/venv-fmu.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+
+section() { printf '\n==== %s ====\n' "$*"; }
+
+section "cargo fmt --check"
+cargo fmt --all -- --check
+
+section "cargo clippy (warnings are errors)"
+cargo clippy --workspace --all-targets --release -- -D warnings
+
+section "Rust tests (release: the physics runs for simulated seconds)"
+cargo test --workspace --release
+
+section "C programs (examples_c/run_tests.sh: build, run, valgrind)"
+examples_c/run_tests.sh
+
+section "FMU (fmu/test.sh: build TissueSim.fmu, fmpy validate and simulate)"
+fmu/test.sh
+
+section "all suites passed"
