@@ -115,7 +115,8 @@ int main(void) {
     CHECK(settings.dt == 1e-3 && settings.gravity[1] < 0 && settings.min_substeps >= 1);
     CHECK(settings.contact_mode == TS_CONTACT_MODE_EXACT_SHAPE);
     CHECK(settings.volume_constraints == 1 && settings.self_contact == 0);
-    CHECK(settings.mass_scaling == 1);
+    CHECK(settings.mass_scaling == 1 && settings.volumetric_split == 1);
+    CHECK(settings.max_depenetration_speed > 0);
     CHECK_OK(ts_material_default(&material));
     CHECK(material.youngs_modulus == 5000 && material.poisson_ratio == 0.45 &&
           material.density == 1060);

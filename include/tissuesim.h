@@ -176,6 +176,11 @@ typedef struct ts_settings {
      */
     double volume_compliance;
     /**
+     * Largest speed (m/s, > 0) at which tool contact pushes a particle out of a tool, so that
+     * a tool jumping into the tissue (a haptic glitch) does not fling particles out.
+     */
+    double max_depenetration_speed;
+    /**
      * Constraint-projection iterations per substep (>= 1).
      */
     uint32_t iterations;
@@ -198,6 +203,12 @@ typedef struct ts_settings {
      * dynamics comparisons against other solvers.
      */
     uint8_t mass_scaling;
+    /**
+     * With volume constraints on, the volumetric part of the stress is carried by the
+     * constraints (compliance 1/lambda + volume_compliance) instead of the particles: 0 off,
+     * non-zero on (the default). Off gives the paper's literal arrangement.
+     */
+    uint8_t volumetric_split;
 } ts_settings;
 
 /**

@@ -921,6 +921,10 @@ fn wrong_sizes_and_ranges() {
             contact_mode: 2,
             ..s
         },
+        ts_settings {
+            max_depenetration_speed: 0.0,
+            ..s
+        },
     ] {
         let mut nw = null_mut();
         assert_eq!(unsafe { ts_world_new(&bad, &mut nw) }, S::InvalidArgument);
@@ -988,6 +992,10 @@ fn non_finite_inputs_leave_the_world_untouched() {
             },
             ts_settings {
                 volume_compliance: bad,
+                ..s
+            },
+            ts_settings {
+                max_depenetration_speed: bad,
                 ..s
             },
         ] {

@@ -43,6 +43,9 @@ pub struct ts_settings {
     pub hourglass_stiffness: f64,
     /// Volume compliance (1/Pa), >= 0; 0 makes every tetrahedron's volume a hard constraint.
     pub volume_compliance: f64,
+    /// Largest speed (m/s, > 0) at which tool contact pushes a particle out of a tool, so that
+    /// a tool jumping into the tissue (a haptic glitch) does not fling particles out.
+    pub max_depenetration_speed: f64,
     /// Constraint-projection iterations per substep (>= 1).
     pub iterations: u32,
     /// How tool-tissue contact is detected: a ts_contact_mode value.
@@ -56,6 +59,10 @@ pub struct ts_settings {
     /// so that the step needs no extra substeps; see ts_body_added_mass. Turn it off for
     /// dynamics comparisons against other solvers.
     pub mass_scaling: u8,
+    /// With volume constraints on, the volumetric part of the stress is carried by the
+    /// constraints (compliance 1/lambda + volume_compliance) instead of the particles: 0 off,
+    /// non-zero on (the default). Off gives the paper's literal arrangement.
+    pub volumetric_split: u8,
 }
 
 impl From<&Settings> for ts_settings {
@@ -70,6 +77,7 @@ impl From<&Settings> for ts_settings {
             damping_stiffness: s.damping_stiffness,
             hourglass_stiffness: s.hourglass_stiffness,
             volume_compliance: s.volume_compliance,
+            max_depenetration_speed: s.max_depenetration_speed,
             iterations: s.iterations,
             contact_mode: match s.contact_mode {
                 ContactMode::ExactShape => ts_contact_mode::ExactShape as u32,
@@ -78,6 +86,7 @@ impl From<&Settings> for ts_settings {
             volume_constraints: s.volume_constraints as u8,
             self_contact: s.self_contact as u8,
             mass_scaling: s.mass_scaling as u8,
+            volumetric_split: s.volumetric_split as u8,
         }
     }
 }
@@ -94,6 +103,10 @@ impl ts_settings {
             ("settings.damping_stiffness", self.damping_stiffness),
             ("settings.hourglass_stiffness", self.hourglass_stiffness),
             ("settings.volume_compliance", self.volume_compliance),
+            (
+                "settings.max_depenetration_speed",
+                self.max_depenetration_speed,
+            ),
         ] {
             finite(v, name)?;
         }
@@ -125,6 +138,8 @@ impl ts_settings {
             contact_mode,
             self_contact: self.self_contact != 0,
             mass_scaling: self.mass_scaling != 0,
+            volumetric_split: self.volumetric_split != 0,
+            max_depenetration_speed: self.max_depenetration_speed,
             ..Settings::default()
         };
         s.validate()?;
