@@ -78,12 +78,14 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
 /// Up to `newton_iterations` warm-started iterations on the objective of Müller, Bender,
 /// Chentanez and Macklin (2016), gradient `g = Σ_c r_c × f_c`, with Newton steps
 /// `δ = H⁻¹ g`, `H = tr(G) I - sym(G)`, `G = F Rᵀ` (quadratic convergence: 1–3 iterations from
-/// the previous step's rotation), until `|g| < 1e-12 |F|`. Where that does not converge (near a
-/// saddle of a strongly inverted `F`, where `H` is indefinite) the rotation is computed exactly
+/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|`. Where that does not
+/// converge (near a saddle of a strongly inverted `F`, where `H` is indefinite) the rotation is computed exactly
 /// from the SVD: `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
+///
+/// Returns the rotation as a matrix.
 #[inline]
-pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) {
-    let tolerance2 = 1.0e-24 * f.norm_squared().max(1.0e-30);
+pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) -> Mat3 {
+    let tolerance2 = ROTATION_TOLERANCE * ROTATION_TOLERANCE * f.norm_squared().max(1.0e-30);
     for _ in 0..newton_iterations {
         let r = q.to_rotation_matrix().into_inner();
         let mut g = Vec3::zeros();
@@ -91,20 +93,39 @@ pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) {
             g += r.column(c).cross(&f.column(c));
         }
         if g.norm_squared() < tolerance2 {
-            return;
+            return r;
         }
+        // Newton step δ = H⁻¹ g, H = tr(G) I - sym(G) (symmetric), by its adjugate when H is
+        // positive definite (Sylvester's criterion); otherwise fall back to the SVD.
         let gm = f * r.transpose();
-        let h = Mat3::identity() * gm.trace() - (gm + gm.transpose()) * 0.5;
-        let Some(chol) = h.cholesky() else {
+        let t = gm.trace();
+        let (a, d, z) = (t - gm[(0, 0)], t - gm[(1, 1)], t - gm[(2, 2)]);
+        let b = -0.5 * (gm[(0, 1)] + gm[(1, 0)]);
+        let c = -0.5 * (gm[(0, 2)] + gm[(2, 0)]);
+        let e = -0.5 * (gm[(1, 2)] + gm[(2, 1)]);
+        let (m00, m01, m02) = (d * z - e * e, c * e - b * z, b * e - c * d);
+        let (m11, m12, m22) = (a * z - c * c, b * c - a * e, a * d - b * b);
+        let det = a * m00 + b * m01 + c * m02;
+        if a <= 0.0 || m22 <= 0.0 || det <= 0.0 {
             break;
-        };
-        let delta = chol.solve(&g);
-        // A rotation by ~|δ| about δ: the normalised quaternion (1, δ/2); no trigonometry.
+        }
+        let delta = Vec3::new(
+            m00 * g.x + m01 * g.y + m02 * g.z,
+            m01 * g.x + m11 * g.y + m12 * g.z,
+            m02 * g.x + m12 * g.y + m22 * g.z,
+        ) / det;
+        // A rotation by ~|δ| about δ: the quaternion (1, δ/2), normalised; no trigonometry.
         let dq = Quaternion::new(1.0, 0.5 * delta.x, 0.5 * delta.y, 0.5 * delta.z);
-        *q = Quat::new_normalize(dq * q.into_inner());
+        let p = dq * q.into_inner();
+        *q = Quat::new_unchecked(p * (1.0 / p.norm()));
     }
     *q = rotation_from_svd(f);
+    q.to_rotation_matrix().into_inner()
 }
+
+/// Convergence tolerance of the rotation extraction: the gradient `|g|` relative to `|F|`
+/// (a rotation error of about this many radians).
+pub const ROTATION_TOLERANCE: Real = 1.0e-10;
 
 /// The proper rotation maximising `tr(Rᵀ f)`, from the SVD of `f` (singular values sorted in
 /// decreasing order; the smallest one's direction flipped when `det(UVᵀ) < 0`).
@@ -169,30 +190,36 @@ pub fn accumulate_forces(
     let damped = model.damping_stiffness > 0.0;
     let pwave = model.p_wave_modulus();
     for i in 0..nbr.particle_count() {
-        let f = deformation_gradient(nbr, x, i);
-        extract_rotation(&f, &mut rotation[i], rotation_iterations);
-        let r = rotation[i].to_rotation_matrix().into_inner();
-        let vi = input.volume[i];
-        let xi = x[i];
         let range = nbr.range(i);
-        let first = range.start;
-        // Hourglass residuals ε_e = F u_e - x_ij and Q = Σ c_e ε_e u_eᵀ.
+        let index = &nbr.index[range.clone()];
+        let rest = &nbr.rest_offset[range.clone()];
+        let grad = &nbr.gradient[range.clone()];
+        let hw = &nbr.hourglass_weight[range];
+        let scratch = &mut scratch[..index.len()];
+        let xi = x[i];
+        // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next pass.
+        let mut f = Mat3::identity();
+        for (((&j, u), d), s) in index.iter().zip(rest).zip(grad).zip(scratch.iter_mut()) {
+            let xij = x[j as usize] - xi;
+            f += (xij - u) * d.transpose();
+            *s = xij;
+        }
+        let r = extract_rotation(&f, &mut rotation[i], rotation_iterations);
+        let vi = input.volume[i];
+        // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ.
         let c_scale = model.hourglass * vi;
         let mut q = Mat3::zeros();
-        for e in range.clone() {
-            let j = nbr.index[e] as usize;
-            let u = nbr.rest_offset[e];
-            let eps = f * u - (x[j] - xi);
-            scratch[e - first] = eps;
-            q += eps * (u.transpose() * (c_scale * nbr.hourglass_weight[e]));
+        for ((u, w), s) in rest.iter().zip(hw).zip(scratch.iter_mut()) {
+            let eps = f * u - *s;
+            *s = eps;
+            q += eps * (u.transpose() * (c_scale * w));
         }
-        // Force on neighbour j: -(v_i P + Q) d_e + c_e ε_e; on i the opposite.
+        // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε; on i the opposite.
         let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + q;
         let mut fi = Vec3::zeros();
-        for e in range {
-            let j = nbr.index[e] as usize;
-            let d = nbr.gradient[e];
-            let mut g = m * d - scratch[e - first] * (c_scale * nbr.hourglass_weight[e]);
+        for (((&j, d), w), eps) in index.iter().zip(grad).zip(hw).zip(scratch.iter()) {
+            let j = j as usize;
+            let mut g = m * d - eps * (c_scale * w);
             if damped {
                 let xij = x[j] - xi;
                 let len2 = xij.norm_squared();

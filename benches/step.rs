@@ -1,0 +1,227 @@
+//! Step timing of the DESIGN §7 haptic scene on the shared livers: ms per step (median, p99,
+//! max, mean), cost per particle, memory per particle; with and without a probe in contact.
+//!
+//! ```text
+//! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k] [--steps N]
+//!                             [--csv PATH]
+//! ```
+//! Scene: mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³, dt = 1 ms, top 10%
+//! of the y range fixed, gravity; the probe is a 1 cm sphere pressed 1 cm into the side of the
+//! organ. Single-threaded (the solver has no threads).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+use tissuesim::{
+    mesh, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+};
+
+/// Counts live heap bytes, for memory per particle.
+struct Counting;
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        LIVE.fetch_add(l.size(), Ordering::Relaxed);
+        System.alloc(l)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        LIVE.fetch_sub(l.size(), Ordering::Relaxed);
+        System.dealloc(p, l)
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        LIVE.fetch_add(n, Ordering::Relaxed);
+        LIVE.fetch_sub(l.size(), Ordering::Relaxed);
+        System.realloc(p, l, n)
+    }
+}
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+struct Row {
+    mesh: String,
+    probe: bool,
+    particles: usize,
+    pairs: usize,
+    substeps: u32,
+    median: f64,
+    p99: f64,
+    max: f64,
+    mean: f64,
+    bytes: usize,
+    contacts: u32,
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let k = ((sorted.len() - 1) as f64 * q).round() as usize;
+    sorted[k]
+}
+
+fn run(name: &str, probe: bool, steps: usize) -> Row {
+    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
+        .join(format!("{name}.node"));
+    let (mut organ, _) = mesh::load(&path, 0.03).unwrap_or_else(|e| panic!("{e}"));
+    let (lo, hi) = organ.bounding_box();
+    let centre = (lo + hi) * 0.5;
+    for p in &mut organ.nodes {
+        *p -= centre;
+    }
+    let (lo, hi) = organ.bounding_box();
+    let live0 = LIVE.load(Ordering::Relaxed);
+    let mut world = World::new(Settings::default()).unwrap();
+    let options = BodyOptions {
+        material: Material {
+            youngs_modulus: 5.0e3,
+            poisson_ratio: 0.45,
+            density: 1060.0,
+        },
+        ..BodyOptions::default()
+    };
+    let body = world.add_body(&organ, &options).unwrap();
+    let top = hi.y - 0.1 * (hi.y - lo.y);
+    world
+        .fix_box(body, Vec3::new(-1.0, top, -1.0), Vec3::new(1.0, 1.0, 1.0))
+        .unwrap();
+    let bytes = LIVE.load(Ordering::Relaxed) - live0;
+    // The probe: 1 cm sphere on the +z side, pressed 1 cm past the surface along -z.
+    let radius = 0.01;
+    let surface_z = organ
+        .nodes
+        .iter()
+        .filter(|p| p.x.abs() < 0.01 && p.y.abs() < 0.01)
+        .map(|p| p.z)
+        .fold(hi.z * 0.5, Real::max);
+    let start = Vec3::new(0.0, 0.0, surface_z + radius + 0.02);
+    let tool = if probe {
+        Some(
+            world
+                .add_tool(
+                    ToolShape::Sphere { radius },
+                    Pose::at(start),
+                    &ToolOptions::default(),
+                )
+                .unwrap(),
+        )
+    } else {
+        None
+    };
+    // Warm-up: the probe moves in over 0.5 s, then everything settles for 0.5 s.
+    for k in 1..=1000 {
+        if let Some(t) = tool {
+            let s = (k as Real / 500.0).min(1.0);
+            let depth = 0.02 + radius * 0.0 + 0.01;
+            world
+                .set_tool_pose(t, Pose::at(start - Vec3::new(0.0, 0.0, depth * s)))
+                .unwrap();
+        }
+        world.step().unwrap();
+    }
+    let mut times = Vec::with_capacity(steps);
+    let mut contacts = 0;
+    for k in 0..steps {
+        if let Some(t) = tool {
+            // A small oscillation keeps the contact alive and changing.
+            let wobble = 0.002 * ((k as Real) * 0.01).sin();
+            world
+                .set_tool_pose(t, Pose::at(start - Vec3::new(0.0, 0.0, 0.03 + wobble)))
+                .unwrap();
+        }
+        let t0 = Instant::now();
+        world.step().unwrap();
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        if let Some(t) = tool {
+            contacts = contacts.max(world.tool(t).unwrap().wrench().contact_count);
+        }
+    }
+    let mean = times.iter().sum::<f64>() / times.len() as f64;
+    times.sort_by(|a, b| a.total_cmp(b));
+    let b = world.body(body).unwrap();
+    Row {
+        mesh: name.to_string(),
+        probe,
+        particles: b.particle_count(),
+        pairs: b.neighbourhoods().pair_count(),
+        substeps: world.substeps_needed().0,
+        median: percentile(&times, 0.5),
+        p99: percentile(&times, 0.99),
+        max: *times.last().unwrap(),
+        mean,
+        bytes,
+        contacts,
+    }
+}
+
+fn main() {
+    let mut meshes = vec![
+        "liver_1k6".to_string(),
+        "liver_4k".to_string(),
+        "liver_10k".to_string(),
+        "liver_31k".to_string(),
+    ];
+    let mut steps = 2000;
+    let mut csv: Option<PathBuf> = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--meshes" => {
+                meshes = args
+                    .next()
+                    .expect("--meshes LIST")
+                    .split(',')
+                    .map(String::from)
+                    .collect()
+            }
+            "--steps" => steps = args.next().expect("--steps N").parse().expect("a number"),
+            "--csv" => csv = Some(PathBuf::from(args.next().expect("--csv PATH"))),
+            "--bench" => {}
+            other => panic!("unknown argument {other}"),
+        }
+    }
+    println!(
+        "{:<10} {:>5} {:>9} {:>8} {:>4} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8} {:>5}",
+        "mesh",
+        "probe",
+        "particles",
+        "pairs",
+        "sub",
+        "median",
+        "p99",
+        "max",
+        "mean",
+        "us/1k part",
+        "B/part",
+        "cont"
+    );
+    let mut out = String::from(
+        "mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
+    );
+    for m in &meshes {
+        for probe in [false, true] {
+            let r = run(m, probe, steps);
+            let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
+            let bpp = r.bytes as f64 / r.particles as f64;
+            println!(
+                "{:<10} {:>5} {:>9} {:>8} {:>4} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>10.1} {:>8.0} {:>5}",
+                r.mesh, r.probe, r.particles, r.pairs, r.substeps, r.median, r.p99, r.max, r.mean, per_k, bpp, r.contacts
+            );
+            out += &format!(
+                "{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
+                r.mesh,
+                r.probe,
+                r.particles,
+                r.pairs,
+                r.substeps,
+                r.median,
+                r.p99,
+                r.max,
+                r.mean,
+                per_k,
+                bpp,
+                r.contacts
+            );
+        }
+    }
+    if let Some(path) = csv {
+        std::fs::write(&path, out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    }
+}
