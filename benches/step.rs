@@ -3,11 +3,16 @@
 //!
 //! ```text
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k] [--steps N]
-//!                             [--csv PATH]
+//!                             [--scene haptic|pypbd] [--csv PATH]
 //! ```
-//! Scene: mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³, dt = 1 ms, top 10%
-//! of the y range fixed, gravity; the probe is a 1 cm sphere pressed 1 cm into the side of the
-//! organ. Single-threaded (the solver has no threads).
+//! Scenes:
+//! - `haptic` (DESIGN §7): mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
+//!   dt = 1 ms, top 10% of the y range fixed, gravity;
+//! - `pypbd` (the peer script `../shared/peers/pypbd_liver.py`): mesh units, E = 3000, ν = 0.45,
+//!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.
+//!
+//! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
+//! by 15% of its size. Single-threaded (the solver has no threads).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::PathBuf;
@@ -57,10 +62,42 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[k]
 }
 
-fn run(name: &str, probe: bool, steps: usize) -> Row {
+/// A benchmark scene: mesh scale, material, fixed fraction of the height.
+#[derive(Clone, Copy)]
+struct Scene {
+    scale: Real,
+    material: Material,
+    fixed_fraction: Real,
+}
+
+fn scene(name: &str) -> Scene {
+    match name {
+        "haptic" => Scene {
+            scale: 0.03,
+            material: Material {
+                youngs_modulus: 5.0e3,
+                poisson_ratio: 0.45,
+                density: 1060.0,
+            },
+            fixed_fraction: 0.1,
+        },
+        "pypbd" => Scene {
+            scale: 1.0,
+            material: Material {
+                youngs_modulus: 3.0e3,
+                poisson_ratio: 0.45,
+                density: 1.0,
+            },
+            fixed_fraction: 0.03,
+        },
+        other => panic!("unknown scene {other} (haptic or pypbd)"),
+    }
+}
+
+fn run(name: &str, scene: Scene, probe: bool, steps: usize) -> Row {
     let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
         .join(format!("{name}.node"));
-    let (mut organ, _) = mesh::load(&path, 0.03).unwrap_or_else(|e| panic!("{e}"));
+    let (mut organ, _) = mesh::load(&path, scene.scale).unwrap_or_else(|e| panic!("{e}"));
     let (lo, hi) = organ.bounding_box();
     let centre = (lo + hi) * 0.5;
     for p in &mut organ.nodes {
@@ -70,28 +107,30 @@ fn run(name: &str, probe: bool, steps: usize) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let mut world = World::new(Settings::default()).unwrap();
     let options = BodyOptions {
-        material: Material {
-            youngs_modulus: 5.0e3,
-            poisson_ratio: 0.45,
-            density: 1060.0,
-        },
+        material: scene.material,
         ..BodyOptions::default()
     };
     let body = world.add_body(&organ, &options).unwrap();
-    let top = hi.y - 0.1 * (hi.y - lo.y);
+    let top = hi.y - scene.fixed_fraction * (hi.y - lo.y);
+    let far = 10.0 * (hi - lo).max();
     world
-        .fix_box(body, Vec3::new(-1.0, top, -1.0), Vec3::new(1.0, 1.0, 1.0))
+        .fix_box(body, Vec3::new(-far, top, -far), Vec3::new(far, far, far))
         .unwrap();
     let bytes = LIVE.load(Ordering::Relaxed) - live0;
-    // The probe: 1 cm sphere on the +z side, pressed 1 cm past the surface along -z.
-    let radius = 0.01;
+    // The probe: a sphere on the +z side at mid-height, moved in along -z until it is pressed
+    // `press` past the first particle it meets.
+    let size = (hi - lo).max();
+    let radius = 0.05 * size;
+    let press = 0.15 * size;
+    let y_mid = 0.5 * (lo.y + top);
     let surface_z = organ
         .nodes
         .iter()
-        .filter(|p| p.x.abs() < 0.01 && p.y.abs() < 0.01)
+        .filter(|p| (p.x.powi(2) + (p.y - y_mid).powi(2)).sqrt() < radius)
         .map(|p| p.z)
-        .fold(hi.z * 0.5, Real::max);
-    let start = Vec3::new(0.0, 0.0, surface_z + radius + 0.02);
+        .fold(lo.z, Real::max);
+    let start = Vec3::new(0.0, y_mid, surface_z + radius + 0.05 * size);
+    let pressed = start - Vec3::new(0.0, 0.0, 0.05 * size + press);
     let tool = if probe {
         Some(
             world
@@ -109,9 +148,8 @@ fn run(name: &str, probe: bool, steps: usize) -> Row {
     for k in 1..=1000 {
         if let Some(t) = tool {
             let s = (k as Real / 500.0).min(1.0);
-            let depth = 0.02 + radius * 0.0 + 0.01;
             world
-                .set_tool_pose(t, Pose::at(start - Vec3::new(0.0, 0.0, depth * s)))
+                .set_tool_pose(t, Pose::at(start.lerp(&pressed, s)))
                 .unwrap();
         }
         world.step().unwrap();
@@ -121,10 +159,8 @@ fn run(name: &str, probe: bool, steps: usize) -> Row {
     for k in 0..steps {
         if let Some(t) = tool {
             // A small oscillation keeps the contact alive and changing.
-            let wobble = 0.002 * ((k as Real) * 0.01).sin();
-            world
-                .set_tool_pose(t, Pose::at(start - Vec3::new(0.0, 0.0, 0.03 + wobble)))
-                .unwrap();
+            let wobble = Vec3::new(0.0, 0.0, 0.01 * size * ((k as Real) * 0.01).sin());
+            world.set_tool_pose(t, Pose::at(pressed + wobble)).unwrap();
         }
         let t0 = Instant::now();
         world.step().unwrap();
@@ -160,6 +196,7 @@ fn main() {
     ];
     let mut steps = 2000;
     let mut csv: Option<PathBuf> = None;
+    let mut scene_name = "haptic".to_string();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -173,6 +210,7 @@ fn main() {
             }
             "--steps" => steps = args.next().expect("--steps N").parse().expect("a number"),
             "--csv" => csv = Some(PathBuf::from(args.next().expect("--csv PATH"))),
+            "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -193,11 +231,11 @@ fn main() {
         "cont"
     );
     let mut out = String::from(
-        "mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
+        "scene,mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
     );
     for m in &meshes {
         for probe in [false, true] {
-            let r = run(m, probe, steps);
+            let r = run(m, scene(&scene_name), probe, steps);
             let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
             let bpp = r.bytes as f64 / r.particles as f64;
             println!(
@@ -205,7 +243,8 @@ fn main() {
                 r.mesh, r.probe, r.particles, r.pairs, r.substeps, r.median, r.p99, r.max, r.mean, per_k, bpp, r.contacts
             );
             out += &format!(
-                "{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
+                "{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
+                scene_name,
                 r.mesh,
                 r.probe,
                 r.particles,
