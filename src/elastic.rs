@@ -206,13 +206,16 @@ pub fn accumulate_forces(
         }
         let r = extract_rotation(&f, &mut rotation[i], rotation_iterations);
         let vi = input.volume[i];
-        // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ.
+        // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ;
+        // skipped without hourglass control (ε then multiplies c = 0 below).
         let c_scale = model.hourglass * vi;
         let mut q = Mat3::zeros();
-        for ((u, w), s) in rest.iter().zip(hw).zip(scratch.iter_mut()) {
-            let eps = f * u - *s;
-            *s = eps;
-            q += eps * (u.transpose() * (c_scale * w));
+        if c_scale != 0.0 {
+            for ((u, w), s) in rest.iter().zip(hw).zip(scratch.iter_mut()) {
+                let eps = f * u - *s;
+                *s = eps;
+                q += eps * (u.transpose() * (c_scale * w));
+            }
         }
         // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε; on i the opposite.
         let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + q;
