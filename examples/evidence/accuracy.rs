@@ -105,6 +105,21 @@ pub struct StaticResult {
     pub converged: bool,
 }
 
+/// Factor on the beam's gravity: the reference is linear elasticity, and at full gravity the
+/// 0.1 m beam's linear tip deflection (7.5 cm) is far outside small strain; the solver is
+/// geometrically nonlinear (corotated), so the beam runs at 1/1000 of the load and its
+/// displacements are scaled back by 1000 (the linear reference scales exactly).
+const BEAM_LOAD_FACTOR: Real = 1.0e-3;
+
+/// Gravity factor of a scene (see [`BEAM_LOAD_FACTOR`]).
+fn load_factor(scene: &str) -> Real {
+    if scene == "cantilever" {
+        BEAM_LOAD_FACTOR
+    } else {
+        1.0
+    }
+}
+
 /// Build the scene: mesh, material, gravity, fixed particles.
 fn build(run: &StaticRun) -> Res<(World, BodyId, TetMesh, usize)> {
     let (mesh, material, g) = match run.scene.as_str() {
@@ -119,7 +134,7 @@ fn build(run: &StaticRun) -> Res<(World, BodyId, TetMesh, usize)> {
                 poisson_ratio: 0.3,
                 density: 1000.0,
             },
-            9.81,
+            9.81 * BEAM_LOAD_FACTOR,
         ),
         "liver030" | "liver045" => (
             load_mesh("liver_4k", run.scale)?,
@@ -205,7 +220,8 @@ pub fn run_static(run: &StaticRun) -> Res<StaticResult> {
         .map(|i| {
             (
                 node_id(&run.scene, &mesh, i),
-                (b.positions()[i] - b.rest_positions()[i]) / (run.scale * run.scale),
+                (b.positions()[i] - b.rest_positions()[i])
+                    / (run.scale * run.scale * load_factor(&run.scene)),
             )
         })
         .collect();
@@ -214,7 +230,7 @@ pub fn run_static(run: &StaticRun) -> Res<StaticResult> {
         substeps,
         steps,
         residual,
-        max_u: b.max_displacement() / (run.scale * run.scale),
+        max_u: b.max_displacement() / (run.scale * run.scale * load_factor(&run.scene)),
         volume_ratio: b.volume_ratio(),
         fixed,
         seconds,
