@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k] [--steps N]
-//!                             [--scene haptic|pypbd] [--csv PATH]
+//!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
 //! ```
 //! Scenes:
 //! - `haptic` (DESIGN §7): mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
@@ -12,7 +12,7 @@
 //!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
-//! by 15% of its size. Single-threaded (the solver has no threads).
+//! by 15% of its size. `--threads` sets `Settings::threads` (default 1).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::PathBuf;
@@ -94,7 +94,7 @@ fn scene(name: &str) -> Scene {
     }
 }
 
-fn run(name: &str, scene: Scene, probe: bool, steps: usize) -> Row {
+fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row {
     let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
         .join(format!("{name}.node"));
     let (mut organ, _) = mesh::load(&path, scene.scale).unwrap_or_else(|e| panic!("{e}"));
@@ -105,7 +105,11 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize) -> Row {
     }
     let (lo, hi) = organ.bounding_box();
     let live0 = LIVE.load(Ordering::Relaxed);
-    let mut world = World::new(Settings::default()).unwrap();
+    let settings = Settings {
+        threads,
+        ..Settings::default()
+    };
+    let mut world = World::new(settings).unwrap();
     let options = BodyOptions {
         material: scene.material,
         ..BodyOptions::default()
@@ -197,6 +201,7 @@ fn main() {
     let mut steps = 2000;
     let mut csv: Option<PathBuf> = None;
     let mut scene_name = "haptic".to_string();
+    let mut threads = 1;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -211,6 +216,7 @@ fn main() {
             "--steps" => steps = args.next().expect("--steps N").parse().expect("a number"),
             "--csv" => csv = Some(PathBuf::from(args.next().expect("--csv PATH"))),
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
+            "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -231,11 +237,11 @@ fn main() {
         "cont"
     );
     let mut out = String::from(
-        "scene,mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
+        "scene,threads,mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
     );
     for m in &meshes {
         for probe in [false, true] {
-            let r = run(m, scene(&scene_name), probe, steps);
+            let r = run(m, scene(&scene_name), probe, steps, threads);
             let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
             let bpp = r.bytes as f64 / r.particles as f64;
             println!(
@@ -243,8 +249,9 @@ fn main() {
                 r.mesh, r.probe, r.particles, r.pairs, r.substeps, r.median, r.p99, r.max, r.mean, per_k, bpp, r.contacts
             );
             out += &format!(
-                "{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
+                "{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
                 scene_name,
+                threads,
                 r.mesh,
                 r.probe,
                 r.particles,

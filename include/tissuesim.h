@@ -209,6 +209,12 @@ typedef struct ts_settings {
      * non-zero on (the default). Off gives the paper's literal arrangement.
      */
     uint8_t volumetric_split;
+    /**
+     * Threads the point-based force computation runs on (1..=64; default 1): the calling
+     * thread plus threads - 1 workers owned by the world. Results are bit-identical for any
+     * count.
+     */
+    uint32_t threads;
 } ts_settings;
 
 /**

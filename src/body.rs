@@ -6,6 +6,7 @@ use crate::error::Error;
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::parallel::Pool;
 use crate::settings::Settings;
 
 /// An isotropic linear-elastic material (SI units).
@@ -86,9 +87,10 @@ pub struct Body {
     pub(crate) p: Vec<Vec3>,
     /// Forces of the current substep (N); scratch.
     pub(crate) force: Vec<Vec3>,
-    /// Per-neighbourhood scratch of the force computation (one entry per pair of the largest
-    /// neighbourhood).
-    pub(crate) pair_scratch: Vec<Vec3>,
+    /// Per-pair forces of the force computation (N), one entry per neighbour pair; scratch.
+    pub(crate) pair_force: Vec<Vec3>,
+    /// Per-particle sums of their pair forces (N); scratch of the multi-threaded force pass.
+    pub(crate) own_force: Vec<Vec3>,
     /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
     pub(crate) mass: Vec<Real>,
     /// Inertial masses (kg): the physical mass plus any mass scaling.
@@ -202,7 +204,8 @@ impl Body {
             v: vec![Vec3::zeros(); n],
             p: mesh.nodes.clone(),
             force: vec![Vec3::zeros(); n],
-            pair_scratch: vec![Vec3::zeros(); max_neighbours(&nbr)],
+            pair_force: vec![Vec3::zeros(); nbr.pair_count()],
+            own_force: vec![Vec3::zeros(); n],
             inv_mass: vec![0.0; n],
             inertial_mass: mass.clone(),
             mass,
@@ -324,7 +327,8 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.x.len()];
         let mut rotation = vec![Quat::identity(); self.x.len()];
-        let mut scratch = vec![Vec3::zeros(); max_neighbours(&self.nbr)];
+        let mut pair_force = vec![Vec3::zeros(); self.nbr.pair_count()];
+        let mut own_force = vec![Vec3::zeros(); self.x.len()];
         let zero = vec![Vec3::zeros(); self.x.len()];
         let input = ForceInputs {
             nbr: &self.nbr,
@@ -337,8 +341,10 @@ impl Body {
             &input,
             &mut rotation,
             50,
-            &mut scratch,
+            &mut pair_force,
+            &mut own_force,
             &mut force,
+            &Pool::new(1),
         );
         force
     }
@@ -423,14 +429,6 @@ impl Body {
         self.inv_mass[i] = 0.0;
         self.v[i] = Vec3::zeros();
     }
-}
-
-/// Number of pairs of the largest neighbourhood.
-fn max_neighbours(nbr: &Neighbourhoods) -> usize {
-    (0..nbr.particle_count())
-        .map(|i| nbr.range(i).len())
-        .max()
-        .unwrap_or(0)
 }
 
 /// Sum of the signed volumes (m³) of `tets` at positions `x`.

@@ -28,6 +28,7 @@
 
 use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::Neighbourhoods;
+use crate::parallel::{Pool, SharedSlice};
 use nalgebra::Quaternion;
 
 /// The constants of the elastic model of one body.
@@ -175,66 +176,152 @@ pub struct ForceInputs<'a> {
 
 /// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
 ///
-/// `rotation` holds each particle's rotation, warm-started and updated in place; `scratch`
-/// must hold at least as many entries as the largest neighbourhood (no allocation inside).
+/// `rotation` holds each particle's rotation, warm-started and updated in place; `pair_force`
+/// (one entry per pair) and `own_force` (one per particle) are scratch: no allocation inside.
+///
+/// Every particle `i` computes its deformation gradient, rotation and stress and the force
+/// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). On one thread the pair forces
+/// are scattered as they are computed. On several, the particles are split into ranges: pass A
+/// stores every `g_ij` and each `Σ_j g_ij`; pass B has each particle `j` sum what concerns it in
+/// exactly the order of the scatter — pairs from particles before `j`, its own sum, pairs from
+/// particles after `j` — so the result is bit-identical for any number of threads.
+#[allow(clippy::too_many_arguments)]
 pub fn accumulate_forces(
     model: &ElasticModel,
     input: &ForceInputs<'_>,
     rotation: &mut [Quat],
     rotation_iterations: u32,
-    scratch: &mut [Vec3],
+    pair_force: &mut [Vec3],
+    own_force: &mut [Vec3],
     force: &mut [Vec3],
+    pool: &Pool,
 ) {
     let nbr = input.nbr;
+    let n = nbr.particle_count();
+    if pool.threads() == 1 {
+        for i in 0..n {
+            let range = nbr.range(i);
+            let pf = &mut pair_force[range.clone()];
+            let fi =
+                particle_pair_forces(model, input, i, &mut rotation[i], rotation_iterations, pf);
+            for (&j, g) in nbr.index[range].iter().zip(pf.iter()) {
+                force[j as usize] -= g;
+            }
+            force[i] += fi;
+        }
+        return;
+    }
+    let rotation = SharedSlice::new(rotation);
+    let pairs = SharedSlice::new(pair_force);
+    let own = SharedSlice::new(own_force);
+    pool.run(&|share| {
+        let particles = pool.share(share, n);
+        let first_pair = nbr.offsets[particles.start] as usize;
+        let last_pair = nbr.offsets[particles.end] as usize;
+        // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
+        let (rot, pf, own) = unsafe {
+            (
+                rotation.range(particles.clone()),
+                pairs.range(first_pair..last_pair),
+                own.range(particles.clone()),
+            )
+        };
+        for (k, i) in particles.enumerate() {
+            let range = nbr.range(i);
+            let local = range.start - first_pair..range.end - first_pair;
+            own[k] = particle_pair_forces(
+                model,
+                input,
+                i,
+                &mut rot[k],
+                rotation_iterations,
+                &mut pf[local],
+            );
+        }
+    });
+    // SAFETY: pass A has finished; pass B only reads these.
+    let (pairs, own) = unsafe { (pairs.range(0..nbr.pair_count()), own.range(0..n)) };
+    let forces = SharedSlice::new(force);
+    pool.run(&|share| {
+        let particles = pool.share(share, n);
+        // SAFETY: shares own disjoint particle ranges.
+        let f = unsafe { forces.range(particles.clone()) };
+        for (k, j) in particles.enumerate() {
+            // Pairs of particles before j have indices below offsets[j].
+            let incoming = nbr.incoming(j);
+            let before = incoming.partition_point(|&e| e < nbr.offsets[j]);
+            let mut fj = f[k];
+            for &e in &incoming[..before] {
+                fj -= pairs[e as usize];
+            }
+            fj += own[j];
+            for &e in &incoming[before..] {
+                fj -= pairs[e as usize];
+            }
+            f[k] = fj;
+        }
+    });
+}
+
+/// Particle `i`'s part of the first pass: its deformation gradient, rotation (warm-started in
+/// `q`) and stress, the force `g_ij` on `i` of each of its pairs written to `pair_force` (one
+/// entry per pair of `i`, also used as scratch), and their sum returned.
+#[inline]
+fn particle_pair_forces(
+    model: &ElasticModel,
+    input: &ForceInputs<'_>,
+    i: usize,
+    q: &mut Quat,
+    rotation_iterations: u32,
+    pair_force: &mut [Vec3],
+) -> Vec3 {
+    let nbr = input.nbr;
     let x = input.x;
+    let range = nbr.range(i);
+    let index = &nbr.index[range.clone()];
+    let rest = &nbr.rest_offset[range.clone()];
+    let grad = &nbr.gradient[range.clone()];
+    let hw = &nbr.hourglass_weight[range];
+    let xi = x[i];
+    // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next pass.
+    let mut f = Mat3::identity();
+    for (((&j, u), d), s) in index.iter().zip(rest).zip(grad).zip(pair_force.iter_mut()) {
+        let xij = x[j as usize] - xi;
+        f += (xij - u) * d.transpose();
+        *s = xij;
+    }
+    let r = extract_rotation(&f, q, rotation_iterations);
+    let vi = input.volume[i];
+    // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ;
+    // skipped without hourglass control (ε then multiplies c = 0 below).
+    let c_scale = model.hourglass * vi;
+    let mut qm = Mat3::zeros();
+    if c_scale != 0.0 {
+        for ((u, w), s) in rest.iter().zip(hw).zip(pair_force.iter_mut()) {
+            let eps = f * u - *s;
+            *s = eps;
+            qm += eps * (u.transpose() * (c_scale * w));
+        }
+    }
+    // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
+    let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + qm;
     let damped = model.damping_stiffness > 0.0;
     let pwave = model.p_wave_modulus();
-    for i in 0..nbr.particle_count() {
-        let range = nbr.range(i);
-        let index = &nbr.index[range.clone()];
-        let rest = &nbr.rest_offset[range.clone()];
-        let grad = &nbr.gradient[range.clone()];
-        let hw = &nbr.hourglass_weight[range];
-        let scratch = &mut scratch[..index.len()];
-        let xi = x[i];
-        // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next pass.
-        let mut f = Mat3::identity();
-        for (((&j, u), d), s) in index.iter().zip(rest).zip(grad).zip(scratch.iter_mut()) {
-            let xij = x[j as usize] - xi;
-            f += (xij - u) * d.transpose();
-            *s = xij;
-        }
-        let r = extract_rotation(&f, &mut rotation[i], rotation_iterations);
-        let vi = input.volume[i];
-        // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ;
-        // skipped without hourglass control (ε then multiplies c = 0 below).
-        let c_scale = model.hourglass * vi;
-        let mut q = Mat3::zeros();
-        if c_scale != 0.0 {
-            for ((u, w), s) in rest.iter().zip(hw).zip(scratch.iter_mut()) {
-                let eps = f * u - *s;
-                *s = eps;
-                q += eps * (u.transpose() * (c_scale * w));
+    let mut fi = Vec3::zeros();
+    for (((&j, d), w), s) in index.iter().zip(grad).zip(hw).zip(pair_force.iter_mut()) {
+        let j = j as usize;
+        let mut g = m * d - *s * (c_scale * w);
+        if damped {
+            let xij = x[j] - xi;
+            let len2 = xij.norm_squared();
+            if len2 > 1.0e-30 {
+                let k = pwave * vi * d.norm_squared();
+                let rate = (input.v[j] - input.v[i]).dot(&xij);
+                g += xij * (model.damping_stiffness * k * rate / len2);
             }
         }
-        // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε; on i the opposite.
-        let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + q;
-        let mut fi = Vec3::zeros();
-        for (((&j, d), w), eps) in index.iter().zip(grad).zip(hw).zip(scratch.iter()) {
-            let j = j as usize;
-            let mut g = m * d - eps * (c_scale * w);
-            if damped {
-                let xij = x[j] - xi;
-                let len2 = xij.norm_squared();
-                if len2 > 1.0e-30 {
-                    let k = pwave * vi * d.norm_squared();
-                    let rate = (input.v[j] - input.v[i]).dot(&xij);
-                    g += xij * (model.damping_stiffness * k * rate / len2);
-                }
-            }
-            fi += g;
-            force[j] -= g;
-        }
-        force[i] += fi;
+        *s = g;
+        fi += g;
     }
+    fi
 }

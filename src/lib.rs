@@ -33,6 +33,7 @@ pub mod ffi;
 pub mod math;
 pub mod mesh;
 pub mod neighbours;
+pub mod parallel;
 pub mod settings;
 pub mod stability;
 pub mod state;

@@ -34,6 +34,11 @@ pub struct Neighbourhoods {
     pub hourglass_weight: Vec<Real>,
     /// Support radius `h_i` of each particle (m).
     pub support_radius: Vec<Real>,
+    /// The transpose: `incoming_offsets[j]..incoming_offsets[j+1]` indexes `incoming`, the pairs
+    /// `e` whose neighbour is `j`, in increasing `e` (length: particles + 1).
+    pub incoming_offsets: Vec<u32>,
+    /// Pair indices grouped by neighbour (see `incoming_offsets`).
+    pub incoming: Vec<u32>,
 }
 
 impl Neighbourhoods {
@@ -49,6 +54,11 @@ impl Neighbourhoods {
     /// Total number of (directed) pairs.
     pub fn pair_count(&self) -> usize {
         self.index.len()
+    }
+    /// The pairs whose neighbour is particle `j`, in increasing pair order.
+    #[inline]
+    pub fn incoming(&self, j: usize) -> &[u32] {
+        &self.incoming[self.incoming_offsets[j] as usize..self.incoming_offsets[j + 1] as usize]
     }
 }
 
@@ -82,6 +92,8 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
         gradient: Vec::new(),
         hourglass_weight: Vec::new(),
         support_radius: Vec::with_capacity(n),
+        incoming_offsets: Vec::new(),
+        incoming: Vec::new(),
     };
     out.offsets.push(0);
     let mut candidates: Vec<(Real, u32)> = Vec::new();
@@ -143,6 +155,20 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
         }
         out.support_radius.push(h);
         out.offsets.push(out.index.len() as u32);
+    }
+    // The transposed pair lists, by counting sort (pairs stay in increasing order).
+    out.incoming_offsets = vec![0; n + 1];
+    for &j in &out.index {
+        out.incoming_offsets[j as usize + 1] += 1;
+    }
+    for j in 0..n {
+        out.incoming_offsets[j + 1] += out.incoming_offsets[j];
+    }
+    let mut fill = out.incoming_offsets.clone();
+    out.incoming = vec![0; out.index.len()];
+    for (e, &j) in out.index.iter().enumerate() {
+        out.incoming[fill[j as usize] as usize] = e as u32;
+        fill[j as usize] += 1;
     }
     Ok(out)
 }

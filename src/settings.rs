@@ -75,6 +75,10 @@ pub struct Settings {
     pub max_depenetration_speed: Real,
     /// Enable contact between particles of the same body (off by default).
     pub self_contact: bool,
+    /// Threads the point-based force computation runs on (≥ 1): the calling thread plus
+    /// `threads - 1` workers owned by the world. Results are bit-identical for any count.
+    /// Default 1: a haptic loop usually owns one core; set 2 on a machine with a free core.
+    pub threads: u32,
 }
 
 impl Default for Settings {
@@ -96,6 +100,7 @@ impl Default for Settings {
             contact_mode: ContactMode::ExactShape,
             max_depenetration_speed: 1.0,
             self_contact: false,
+            threads: 1,
         }
     }
 }
@@ -131,6 +136,9 @@ impl Settings {
         }
         if !(self.max_depenetration_speed.is_finite() && self.max_depenetration_speed > 0.0) {
             return bad("max_depenetration_speed must be finite and > 0 m/s");
+        }
+        if !(1..=64).contains(&self.threads) {
+            return bad("threads must be in 1..=64");
         }
         if self.iterations == 0 {
             return bad("iterations must be >= 1");

@@ -25,6 +25,7 @@ use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::error::Error;
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
+use crate::parallel::Pool;
 use crate::settings::{ContactMode, Settings};
 use parry3d_f64::math::Point;
 
@@ -60,6 +61,7 @@ pub struct World {
     pub(crate) tools: Vec<Tool>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
+    pool: Pool,
     pub(crate) time: Real,
     diverged_steps: u64,
 }
@@ -69,6 +71,7 @@ impl World {
     pub fn new(settings: Settings) -> Result<Self, Error> {
         settings.validate()?;
         Ok(World {
+            pool: Pool::new(settings.threads as usize),
             settings,
             bodies: Vec::new(),
             tools: Vec::new(),
@@ -99,6 +102,9 @@ impl World {
             for b in &mut self.bodies {
                 b.configure(&settings);
             }
+        }
+        if settings.threads != s.threads {
+            self.pool = Pool::new(settings.threads as usize);
         }
         self.settings = settings;
         Ok(())
@@ -377,7 +383,7 @@ impl World {
         let gravity = s.gravity;
         let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
         for body in &mut self.bodies {
-            predict(body, gravity, h, alpha_damp);
+            predict(body, gravity, h, alpha_damp, &self.pool);
         }
         let organ_contact = self.bodies.len() > 1 || s.self_contact;
         if organ_contact {
@@ -470,7 +476,7 @@ impl World {
 }
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s).
-fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real) {
+fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real, pool: &Pool) {
     for i in 0..body.x.len() {
         body.force[i] = gravity * body.mass[i];
     }
@@ -485,8 +491,10 @@ fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real) {
         &input,
         &mut body.rotation,
         ROTATION_ITERATIONS,
-        &mut body.pair_scratch,
+        &mut body.pair_force,
+        &mut body.own_force,
         &mut body.force,
+        pool,
     );
     for i in 0..body.x.len() {
         let w = body.inv_mass[i];

@@ -1,25 +1,23 @@
 //! No heap allocation inside a step after the first: two bodies in organ–organ contact, a probe
-//! with friction pressing one of them, in both contact modes.
+//! with friction pressing one of them, in both contact modes, on one and on two threads. Every
+//! thread's allocations are counted (this file holds a single test, so nothing else runs).
 
 mod common;
 
 use common::{fix_top, liver, tissue};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use tissuesim::mesh::default_organ;
 use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3, World};
 
 struct Counting;
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-thread_local! {
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
+static COUNTING: AtomicBool = AtomicBool::new(false);
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.with(|c| c.get()) {
+        if COUNTING.load(Ordering::SeqCst) {
             ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
         }
         System.alloc(layout)
@@ -28,7 +26,7 @@ unsafe impl GlobalAlloc for Counting {
         System.dealloc(ptr, layout)
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.with(|c| c.get()) {
+        if COUNTING.load(Ordering::SeqCst) {
             ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
         }
         System.realloc(ptr, layout, new_size)
@@ -40,17 +38,22 @@ static GLOBAL: Counting = Counting;
 
 fn allocations_during(f: impl FnOnce()) -> usize {
     let before = ALLOCATIONS.load(Ordering::SeqCst);
-    COUNTING.with(|c| c.set(true));
+    COUNTING.store(true, Ordering::SeqCst);
     f();
-    COUNTING.with(|c| c.set(false));
+    COUNTING.store(false, Ordering::SeqCst);
     ALLOCATIONS.load(Ordering::SeqCst) - before
 }
 
 #[test]
 fn steps_after_the_first_do_not_allocate() {
-    for mode in [ContactMode::ExactShape, ContactMode::SampledPoints] {
+    for (mode, threads) in [
+        (ContactMode::ExactShape, 1),
+        (ContactMode::SampledPoints, 1),
+        (ContactMode::ExactShape, 2),
+    ] {
         let settings = Settings {
             contact_mode: mode,
+            threads,
             ..Settings::default()
         };
         let mut world = World::new(settings).unwrap();

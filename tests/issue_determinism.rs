@@ -8,7 +8,15 @@ use tissuesim::mesh::default_organ;
 use tissuesim::{Pose, Settings, ToolOptions, ToolShape, Vec3, World};
 
 fn scene() -> World {
-    let mut world = World::new(Settings::default()).unwrap();
+    scene_with_threads(1)
+}
+
+fn scene_with_threads(threads: u32) -> World {
+    let settings = Settings {
+        threads,
+        ..Settings::default()
+    };
+    let mut world = World::new(settings).unwrap();
     let a = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
     fix_top(&mut world, a, 0.1);
     let mut organ = default_organ();
@@ -73,6 +81,23 @@ fn two_runs_give_identical_bits() {
     assert_eq!(
         w1.tool(tissuesim::ToolId(0)).unwrap().wrench(),
         w2.tool(tissuesim::ToolId(0)).unwrap().wrench()
+    );
+}
+
+#[test]
+fn thread_count_does_not_change_a_bit() {
+    let mut one = scene_with_threads(1);
+    let mut two = scene_with_threads(2);
+    let mut three = scene_with_threads(3);
+    for w in [&mut one, &mut two, &mut three] {
+        drive(w, 0, 300);
+    }
+    assert_eq!(positions(&one), positions(&two));
+    assert_eq!(positions(&one), positions(&three));
+    let tool = tissuesim::ToolId(0);
+    assert_eq!(
+        one.tool(tool).unwrap().wrench(),
+        three.tool(tool).unwrap().wrench()
     );
 }
 

@@ -63,6 +63,10 @@ pub struct ts_settings {
     /// constraints (compliance 1/lambda + volume_compliance) instead of the particles: 0 off,
     /// non-zero on (the default). Off gives the paper's literal arrangement.
     pub volumetric_split: u8,
+    /// Threads the point-based force computation runs on (1..=64; default 1): the calling
+    /// thread plus threads - 1 workers owned by the world. Results are bit-identical for any
+    /// count.
+    pub threads: u32,
 }
 
 impl From<&Settings> for ts_settings {
@@ -87,6 +91,7 @@ impl From<&Settings> for ts_settings {
             self_contact: s.self_contact as u8,
             mass_scaling: s.mass_scaling as u8,
             volumetric_split: s.volumetric_split as u8,
+            threads: s.threads,
         }
     }
 }
@@ -132,6 +137,7 @@ impl ts_settings {
             damping_mass: self.damping_mass,
             damping_stiffness: self.damping_stiffness,
             hourglass_stiffness: self.hourglass_stiffness,
+            threads: self.threads,
             volume_constraints: self.volume_constraints != 0,
             volume_compliance: self.volume_compliance,
             iterations: self.iterations,
