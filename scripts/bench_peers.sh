@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Speed: tissuesim against Bender's PositionBasedDynamics (pypbd) on the same meshes, scene and
-# dt, in one run; then tissuesim alone on the DESIGN §7 haptic scene with and without a probe.
+# dt, in one run (each on one thread and on two); then tissuesim alone on the DESIGN §7 haptic
+# scene with and without a probe.
 #
 #   scripts/bench_peers.sh [meshes (default liver_1k6,liver_4k,liver_10k)] [steps (default 1000)]
 #
 # Peer scene (../shared/peers/pypbd_liver.py): mesh units, E = 3000, nu = 0.45, rho = 1,
 # dt = 1 ms, top 3% fixed, gravity; pypbd: FEM-based PBD tet constraints, 5 iterations, run with
-# OMP_NUM_THREADS=1 and =2. tissuesim runs the same scene single-threaded (cargo bench --bench
-# step -- --scene pypbd). The peer prints a mean over its steps, so the ratio is of means;
-# tissuesim's median and p99 are given beside it. Writes docs/data/peers.csv and
-# docs/data/bench_haptic.csv. Run it on an otherwise idle machine.
+# OMP_NUM_THREADS=1 and =2. tissuesim runs the same scene with Settings::threads 1 and 2 (cargo
+# bench --bench step -- --scene pypbd --threads N). The peer prints a mean over its steps, so the
+# ratios are of means (1 thread vs 1 thread, 2 vs 2); tissuesim's median and p99 are given beside
+# them. Writes docs/data/peers.csv and docs/data/bench_haptic.csv. Run it on an idle machine.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -24,24 +25,30 @@ trap 'rm -rf "$TMP"' EXIT
 validation/setup_venv.sh >/dev/null
 cargo bench --bench step --no-run -q
 
-echo "mesh,nodes,tissuesim_median_ms,tissuesim_p99_ms,tissuesim_mean_ms,pypbd_1thread_ms,pypbd_2threads_ms,ratio_1thread,ratio_2threads,pypbd_volume_ratio" > "$OUT/peers.csv"
-printf '%-10s %7s | %-28s | %-19s | %s\n' "mesh" "nodes" "tissuesim median/p99/mean ms" "pypbd 1t / 2t ms" "speed-up 1t / 2t"
+echo "mesh,nodes,tissuesim_1t_median_ms,tissuesim_1t_p99_ms,tissuesim_1t_mean_ms,tissuesim_2t_median_ms,tissuesim_2t_p99_ms,tissuesim_2t_mean_ms,pypbd_1t_ms,pypbd_2t_ms,ratio_1t,ratio_2t,pypbd_volume_ratio" > "$OUT/peers.csv"
+printf '%-10s %6s | %-24s | %-24s | %-17s | %s\n' "mesh" "nodes" "ours 1t median/p99/mean" "ours 2t median/p99/mean" "pypbd 1t / 2t" "speed-up 1t / 2t"
+ours() { # mesh threads -> "nodes median p99 mean" of the run without probe
+  cargo bench -q --bench step -- --scene pypbd --meshes "$1" --steps "$STEPS" --threads "$2" --csv "$TMP/ours.csv" >/dev/null
+  # scene,threads,mesh,probe,particles,pairs,substeps,median,p99,max,mean,...
+  grep ",false," "$TMP/ours.csv" | awk -F, '{print $5, $8, $9, $11}'
+}
 IFS=',' read -ra LIST <<< "$MESHES"
 for mesh in "${LIST[@]}"; do
-  cargo bench -q --bench step -- --scene pypbd --meshes "$mesh" --steps "$STEPS" --csv "$TMP/ours.csv" >/dev/null
-  # Row without the probe: scene,mesh,probe,particles,pairs,substeps,median,p99,max,mean,...
-  IFS=',' read -r _ _ _ nodes _ _ median p99 _ mean _ < <(grep ",false," "$TMP/ours.csv")
+  read -r nodes m1 q1 a1 < <(ours "$mesh" 1)
+  read -r _ m2 q2 a2 < <(ours "$mesh" 2)
   p1=$(OMP_NUM_THREADS=1 validation/peer_pypbd.sh "$mesh" 200)
   p2=$(OMP_NUM_THREADS=2 validation/peer_pypbd.sh "$mesh" 200)
   ms1=$(echo "$p1" | awk '{print $4}')
   ms2=$(echo "$p2" | awk '{print $4}')
   vol=$(echo "$p1" | awk '{print $5}')
-  r1=$(awk -v a="$ms1" -v b="$mean" 'BEGIN{printf "%.1f", a/b}')
-  r2=$(awk -v a="$ms2" -v b="$mean" 'BEGIN{printf "%.1f", a/b}')
-  echo "$mesh,$nodes,$median,$p99,$mean,$ms1,$ms2,$r1,$r2,$vol" >> "$OUT/peers.csv"
-  printf '%-10s %7s | %8.3f %8.3f %8.3f    | %8.3f %8.3f   | %5sx %5sx\n' "$mesh" "$nodes" "$median" "$p99" "$mean" "$ms1" "$ms2" "$r1" "$r2"
+  r1=$(awk -v a="$ms1" -v b="$a1" 'BEGIN{printf "%.1f", a/b}')
+  r2=$(awk -v a="$ms2" -v b="$a2" 'BEGIN{printf "%.1f", a/b}')
+  echo "$mesh,$nodes,$m1,$q1,$a1,$m2,$q2,$a2,$ms1,$ms2,$r1,$r2,$vol" >> "$OUT/peers.csv"
+  printf '%-10s %6s | %7.3f %7.3f %7.3f  | %7.3f %7.3f %7.3f  | %7.3f %7.3f | %5sx %5sx\n' "$mesh" "$nodes" "$m1" "$q1" "$a1" "$m2" "$q2" "$a2" "$ms1" "$ms2" "$r1" "$r2"
 done
 
 echo
-echo "DESIGN §7 haptic scene (SI, dt = 1 ms), single-threaded:"
-cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --csv "$OUT/bench_haptic.csv"
+echo "DESIGN §7 haptic scene (SI, dt = 1 ms), 1 and 2 threads:"
+cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads 1 --csv "$TMP/h1.csv"
+cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads 2 --csv "$TMP/h2.csv"
+{ cat "$TMP/h1.csv"; tail -n +2 "$TMP/h2.csv"; } > "$OUT/bench_haptic.csv"
