@@ -172,7 +172,9 @@ typedef struct ts_settings {
      */
     double hourglass_stiffness;
     /**
-     * Volume compliance (1/Pa), >= 0; 0 makes every tetrahedron's volume a hard constraint.
+     * Compliance (1/Pa, per unit volume, >= 0) of the volume constraints in addition to the
+     * material's 1/lambda under the volumetric split (the default: 0 keeps the material's own
+     * compressibility), or in total without the split (0 = hard constraints).
      */
     double volume_compliance;
     /**

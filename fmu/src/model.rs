@@ -229,7 +229,7 @@ pub static VARIABLES: &[Variable] = &[
     param(vr::TOOL_RADIUS, "tool_radius", Fixed, "m", 0.01, Some(0.0), "Tool radius (sphere, capsule, cylinder) or half width (box)"),
     param(vr::TOOL_HALF_LENGTH, "tool_half_length", Fixed, "m", 0.03, Some(0.0), "Half length of a capsule, cylinder or box along the tool's local y axis"),
     param(vr::INTERNAL_STEP, "internal_step", Tunable, "s", 1.0e-3, Some(0.0), "Largest internal time step: fmi2DoStep(h) runs ceil(h/internal_step) world steps of equal length"),
-    param(vr::VOLUME_COMPLIANCE, "volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Compliance of the per-tetrahedron volume constraints (inverse bulk modulus); 0 = hard"),
+    param(vr::VOLUME_COMPLIANCE, "volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Extra compliance of the per-tetrahedron volume constraints, added to the material's 1/lambda; 0 = the material's own compressibility"),
     Variable {
         name: "volume_constraints",
         vr: vr::VOLUME_CONSTRAINTS,

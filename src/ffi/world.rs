@@ -41,7 +41,9 @@ pub struct ts_settings {
     pub damping_stiffness: f64,
     /// Hourglass-control stiffness (dimensionless, times Young's modulus), >= 0.
     pub hourglass_stiffness: f64,
-    /// Volume compliance (1/Pa), >= 0; 0 makes every tetrahedron's volume a hard constraint.
+    /// Compliance (1/Pa, per unit volume, >= 0) of the volume constraints in addition to the
+    /// material's 1/lambda under the volumetric split (the default: 0 keeps the material's own
+    /// compressibility), or in total without the split (0 = hard constraints).
     pub volume_compliance: f64,
     /// Largest speed (m/s, > 0) at which tool contact pushes a particle out of a tool, so that
     /// a tool jumping into the tissue (a haptic glitch) does not fling particles out.
