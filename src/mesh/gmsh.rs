@@ -180,6 +180,16 @@ fn shorten(s: &str) -> String {
     }
 }
 
+/// The next record line of a section, described by `what` (e.g. "node 3 of 10"); a section
+/// marker (`$...`) there means the section's count was wrong.
+fn record_line<'a>(lines: &mut Lines<'a>, what: &str) -> Result<Line<'a>, MeshError> {
+    let l = lines.expect_line(what)?;
+    if l.text.starts_with('$') {
+        return Err(l.error(format!("expected {what}, found `{}`", l.text)));
+    }
+    Ok(l)
+}
+
 /// Consume the line closing a section, which must be `end`.
 fn expect_end(lines: &mut Lines<'_>, end: &str) -> Result<(), MeshError> {
     let l = lines.expect_line(&format!("`{end}`"))?;
@@ -215,14 +225,7 @@ fn read_nodes_v1(
     let n = read_count(lines, "number of nodes")?;
     raw.nodes.reserve(prealloc(n));
     for k in 0..n {
-        let l = lines.expect_line(&format!("node {} of {n}", k + 1))?;
-        if l.text.starts_with('$') {
-            return Err(l.error(format!(
-                "expected node {} of {n}, found `{}`",
-                k + 1,
-                l.text
-            )));
-        }
+        let l = record_line(lines, &format!("node {} of {n}", k + 1))?;
         let mut f = l.fields();
         let id: i64 = f.next("node id")?;
         let p = f.next_point(scale)?;
@@ -236,14 +239,7 @@ fn read_elements_v1(lines: &mut Lines<'_>, raw: &mut Raw, end: &str) -> Result<(
     raw.saw_elements = true;
     let n = read_count(lines, "number of elements")?;
     for k in 0..n {
-        let l = lines.expect_line(&format!("element {} of {n}", k + 1))?;
-        if l.text.starts_with('$') {
-            return Err(l.error(format!(
-                "expected element {} of {n}, found `{}`",
-                k + 1,
-                l.text
-            )));
-        }
+        let l = record_line(lines, &format!("element {} of {n}", k + 1))?;
         let mut f = l.fields();
         let _number: i64 = f.next("element number")?;
         let kind: u32 = f.next("element type")?;
@@ -272,14 +268,7 @@ fn read_elements_v2(lines: &mut Lines<'_>, raw: &mut Raw) -> Result<(), MeshErro
     raw.saw_elements = true;
     let n = read_count(lines, "number of elements")?;
     for k in 0..n {
-        let l = lines.expect_line(&format!("element {} of {n}", k + 1))?;
-        if l.text.starts_with('$') {
-            return Err(l.error(format!(
-                "expected element {} of {n}, found `{}`",
-                k + 1,
-                l.text
-            )));
-        }
+        let l = record_line(lines, &format!("element {} of {n}", k + 1))?;
         let mut f = l.fields();
         let _number: i64 = f.next("element number")?;
         let kind: u32 = f.next("element type")?;
@@ -371,14 +360,7 @@ fn read_elements_v41(lines: &mut Lines<'_>, raw: &mut Raw) -> Result<(), MeshErr
         let count: usize = f.next("number of elements in block")?;
         let expected = nodes_per_element(kind);
         for k in 0..count {
-            let l = lines.expect_line(&format!("element {} of {count} of the block", k + 1))?;
-            if l.text.starts_with('$') {
-                return Err(l.error(format!(
-                    "expected element {} of {count} of the block, found `{}`",
-                    k + 1,
-                    l.text
-                )));
-            }
+            let l = record_line(lines, &format!("element {} of {count} of the block", k + 1))?;
             let mut f = l.fields();
             let _number: i64 = f.next("element tag")?;
             let ids = f.rest();
