@@ -1,0 +1,92 @@
+//! Diagnostic for docs/VALIDATION.md §1.4: the gravity sag of the project's own quasi-uniform
+//! default organ (scaled ×30 to liver size, mesh units), the liver scene's material (E 3000,
+//! ν 0.3, ρ 1, g 0.981, top 10% fixed), compared with scikit-fem by `validation/organ_check.sh`.
+//!
+//! ```text
+//! cargo run --release --example organ_check -- export DIR          # DIR/organ.node, .ele
+//! cargo run --release --example organ_check -- run CSV [HOURGLASS]  # node,ux,uy,uz at equilibrium
+//! ```
+
+use std::io::Write;
+use std::path::Path;
+use tissuesim::{BodyOptions, Material, Settings, Vec3, World};
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut organ = tissuesim::mesh::default_organ();
+    for p in &mut organ.nodes {
+        *p *= 30.0;
+    }
+    match args.first().map(String::as_str) {
+        Some("export") => {
+            let dir = Path::new(args.get(1).ok_or("export DIR")?);
+            std::fs::create_dir_all(dir)?;
+            let mut f = std::fs::File::create(dir.join("organ.node"))?;
+            writeln!(f, "{} 3 0 0", organ.nodes.len())?;
+            for (i, p) in organ.nodes.iter().enumerate() {
+                writeln!(f, "{i} {:.17e} {:.17e} {:.17e}", p.x, p.y, p.z)?;
+            }
+            let mut f = std::fs::File::create(dir.join("organ.ele"))?;
+            writeln!(f, "{} 4 0", organ.tets.len())?;
+            for (i, t) in organ.tets.iter().enumerate() {
+                writeln!(f, "{i} {} {} {} {}", t[0], t[1], t[2], t[3])?;
+            }
+            Ok(())
+        }
+        Some("run") => {
+            let out = args.get(1).ok_or("run CSV [HOURGLASS]")?;
+            let hourglass = match args.get(2) {
+                Some(h) => h.parse()?,
+                None => Settings::default().hourglass_stiffness,
+            };
+            run(&organ, Path::new(out), hourglass)
+        }
+        _ => Err("usage: organ_check export DIR | run CSV [HOURGLASS]".into()),
+    }
+}
+
+fn run(organ: &tissuesim::mesh::TetMesh, out: &Path, hourglass: f64) -> Res<()> {
+    let settings = Settings {
+        dt: 0.002,
+        gravity: Vec3::new(0.0, -0.981, 0.0),
+        damping_mass: 15.0,
+        hourglass_stiffness: hourglass,
+        ..Settings::default()
+    };
+    let mut world = World::new(settings)?;
+    let material = Material {
+        youngs_modulus: 3000.0,
+        poisson_ratio: 0.3,
+        density: 1.0,
+    };
+    let options = BodyOptions {
+        material,
+        ..BodyOptions::default()
+    };
+    let id = world.add_body(organ, &options)?;
+    let (lo, hi) = organ.bounding_box();
+    let threshold = hi.y - 0.1 * (hi.y - lo.y);
+    let fixed: Vec<u32> = (0..organ.nodes.len() as u32)
+        .filter(|&i| organ.nodes[i as usize].y >= threshold)
+        .collect();
+    world.fix_particles(id, &fixed)?;
+    for _ in 0..8000 {
+        world.step()?;
+    }
+    let b = world.body(id)?;
+    let speed = b.velocities().iter().map(|v| v.norm()).fold(0.0, f64::max);
+    eprintln!(
+        "organ_check: {} fixed, hourglass {hourglass}, max |u| {:.4e}, residual speed {speed:.1e}",
+        fixed.len(),
+        b.max_displacement()
+    );
+    let mut f = std::fs::File::create(out)?;
+    writeln!(f, "node,ux,uy,uz")?;
+    for (i, (p, r)) in b.positions().iter().zip(b.rest_positions()).enumerate() {
+        let u = p - r;
+        writeln!(f, "{i},{:.17e},{:.17e},{:.17e}", u.x, u.y, u.z)?;
+    }
+    Ok(())
+}
