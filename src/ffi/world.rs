@@ -346,15 +346,8 @@ pub unsafe extern "C" fn ts_world_step(
 /// `world` is NULL or a live handle; `out_time` is NULL or writable.
 #[no_mangle]
 pub unsafe extern "C" fn ts_world_time(world: *const ts_world, out_time: *mut f64) -> ts_status {
-    guard(|| {
-        non_null(out_time, "out_time")?;
-        // SAFETY: contract of this function.
-        let h = unsafe { world_ref(world)? };
-        let t = h.world.time();
-        // SAFETY: checked non-NULL.
-        unsafe { write(out_time, t) };
-        Ok(())
-    })
+    // SAFETY: contract of this function.
+    unsafe { world_value(world, out_time, "out_time", |w| w.time()) }
 }
 
 /// Number of bodies in the world (their ids are 0 .. count-1).
@@ -367,15 +360,8 @@ pub unsafe extern "C" fn ts_world_body_count(
     world: *const ts_world,
     out_count: *mut u32,
 ) -> ts_status {
-    guard(|| {
-        non_null(out_count, "out_count")?;
-        // SAFETY: contract of this function.
-        let h = unsafe { world_ref(world)? };
-        let n = h.world.body_count() as u32;
-        // SAFETY: checked non-NULL.
-        unsafe { write(out_count, n) };
-        Ok(())
-    })
+    // SAFETY: contract of this function.
+    unsafe { world_value(world, out_count, "out_count", |w| w.body_count() as u32) }
 }
 
 /// Number of tools in the world (their ids are 0 .. count-1).
@@ -388,15 +374,8 @@ pub unsafe extern "C" fn ts_world_tool_count(
     world: *const ts_world,
     out_count: *mut u32,
 ) -> ts_status {
-    guard(|| {
-        non_null(out_count, "out_count")?;
-        // SAFETY: contract of this function.
-        let h = unsafe { world_ref(world)? };
-        let n = h.world.tool_count() as u32;
-        // SAFETY: checked non-NULL.
-        unsafe { write(out_count, n) };
-        Ok(())
-    })
+    // SAFETY: contract of this function.
+    unsafe { world_value(world, out_count, "out_count", |w| w.tool_count() as u32) }
 }
 
 /// Number of steps so far that produced NaN/Inf and were rolled back (TS_STATUS_DIVERGED).
@@ -409,13 +388,28 @@ pub unsafe extern "C" fn ts_world_diverged_steps(
     world: *const ts_world,
     out_count: *mut u64,
 ) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { world_value(world, out_count, "out_count", |w| w.diverged_steps()) }
+}
+
+/// Write `get(world)` into `*out` (`out_name` names it in errors): the world-wide getters.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or writable.
+unsafe fn world_value<T>(
+    world: *const ts_world,
+    out: *mut T,
+    out_name: &str,
+    get: impl FnOnce(&World) -> T,
+) -> ts_status {
     guard(|| {
-        non_null(out_count, "out_count")?;
-        // SAFETY: contract of this function.
+        non_null(out, out_name)?;
+        // SAFETY: contract of the caller.
         let h = unsafe { world_ref(world)? };
-        let n = h.world.diverged_steps();
+        let v = get(&h.world);
         // SAFETY: checked non-NULL.
-        unsafe { write(out_count, n) };
+        unsafe { write(out, v) };
         Ok(())
     })
 }
