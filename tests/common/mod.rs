@@ -99,7 +99,7 @@ pub fn tet_volumes(x: &[Vec3], tets: &[[u32; 4]]) -> Vec<Real> {
     tets.iter()
         .map(|t| {
             let [a, b, c, d] = t.map(|k| x[k as usize]);
-            (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
+            tissuesim::math::tet_volume(&a, &b, &c, &d)
         })
         .collect()
 }
