@@ -1,4 +1,4 @@
-//! Step timing of the DESIGN §7 haptic scene on the shared livers: ms per step (median, p99,
+//! Step timing of the DESIGN §7 haptic scene on the test livers (data/meshes): ms per step (median, p99,
 //! max, mean), cost per particle, memory per particle; with and without a probe in contact.
 //!
 //! ```text
@@ -8,7 +8,7 @@
 //! Scenes:
 //! - `haptic` (DESIGN §7): mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
 //!   dt = 1 ms, top 10% of the y range fixed, gravity;
-//! - `pypbd` (the peer script `../shared/peers/pypbd_liver.py`): mesh units, E = 3000, ν = 0.45,
+//! - `pypbd` (the peer script `validation/peers/pypbd_liver.py`): mesh units, E = 3000, ν = 0.45,
 //!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
@@ -94,9 +94,30 @@ fn scene(name: &str) -> Scene {
     }
 }
 
+/// The TetGen mesh `file` in `$TISSUESIM_MESHES` when set, else in the repository's
+/// `data/meshes`; panics naming the full path looked at when it is not there.
+fn mesh_path(file: &str) -> PathBuf {
+    let env = std::env::var_os("TISSUESIM_MESHES");
+    let dir = match &env {
+        Some(dir) => PathBuf::from(dir),
+        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/data/meshes")),
+    };
+    let path = dir.join(file);
+    if !path.is_file() {
+        let from = match env {
+            Some(dir) => format!("TISSUESIM_MESHES={}", dir.to_string_lossy()),
+            None => "TISSUESIM_MESHES is not set, so the repository's data/meshes".to_string(),
+        };
+        panic!(
+            "mesh not found: {} (looked there because {from})",
+            path.display()
+        );
+    }
+    path
+}
+
 fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row {
-    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"))
-        .join(format!("{name}.node"));
+    let path = mesh_path(&format!("{name}.node"));
     let (mut organ, _) = mesh::load(&path, scene.scale).unwrap_or_else(|e| panic!("{e}"));
     let (lo, hi) = organ.bounding_box();
     let centre = (lo + hi) * 0.5;

@@ -11,7 +11,7 @@
 //! cargo run --release --example evidence -- large --out DIR          # paper Fig. 9 (+ VTU into DIR/vtu)
 //! cargo run --release --example evidence -- press --out CSV          # issue #3 probe force trace
 //! ```
-//! Meshes are read from `../shared/meshes` beside the repository, or from `$TISSUESIM_MESHES`.
+//! Meshes are read from the repository's `data/meshes`, or from `$TISSUESIM_MESHES` when set.
 
 #[path = "evidence/accuracy.rs"]
 mod accuracy;

@@ -7,8 +7,8 @@
 #   examples_c/run_tests.sh            from anywhere in the repository
 #
 # Environment: CARGO_TARGET_DIR (default: target), CC (default: cc), SOFA_LIVER (default:
-# ../shared/meshes/liver.msh relative to the repository root), SKIP_VALGRIND=1 to skip the
-# valgrind runs.
+# $TISSUESIM_MESHES/liver.msh when TISSUESIM_MESHES is set, else data/meshes/liver.msh in the
+# repository; a missing file is a failure, not a skip), SKIP_VALGRIND=1 to skip the valgrind runs.
 set -u
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,7 +19,7 @@ LIB_DIR="$TARGET_DIR/release"
 OUT="$TARGET_DIR/examples_c"
 CC="${CC:-cc}"
 CFLAGS=(-Wall -Wextra -Wpedantic -Werror -std=c11 -O2 -g -I"$ROOT/include")
-LIVER="${SOFA_LIVER:-$ROOT/../shared/meshes/liver.msh}"
+LIVER="${SOFA_LIVER:-${TISSUESIM_MESHES:-$ROOT/data/meshes}/liver.msh}"
 mkdir -p "$OUT"
 
 passed=0
@@ -111,7 +111,7 @@ echo "== running"
 if [ -f "$LIVER" ]; then
     [ -x "$OUT/sofa_liver" ] && run sofa_liver -- "$OUT/sofa_liver" "$LIVER" "$OUT/sofa_liver.csv"
 else
-    echo "SKIP sofa_liver: $LIVER not found (set SOFA_LIVER=PATH/TO/liver.msh)"
+    fail "sofa_liver: mesh not found at $LIVER (from SOFA_LIVER, else TISSUESIM_MESHES, else data/meshes)"
 fi
 [ -x "$OUT/test_api" ] && run test_api -- "$OUT/test_api"
 [ -x "$OUT/test_api_static" ] && run test_api_static -- "$OUT/test_api_static"
@@ -143,7 +143,7 @@ if [ -f "$LIVER" ]; then
     [ -x "$OUT/sofa_liver" ] && run valgrind-sofa_liver TS_STEPS=5 -- \
         "${VG[@]}" "$OUT/sofa_liver" "$LIVER" "$OUT/sofa_liver_valgrind.csv"
 else
-    echo "SKIP valgrind-sofa_liver: $LIVER not found"
+    fail "valgrind-sofa_liver: mesh not found at $LIVER"
 fi
 [ -x "$OUT/test_api" ] && run valgrind-test_api TS_STEPS=3 -- "${VG[@]}" "$OUT/test_api"
 [ -x "$OUT/test_api_static" ] && run valgrind-test_api_static TS_STEPS=3 -- \

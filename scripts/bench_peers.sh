@@ -5,7 +5,7 @@
 #
 #   scripts/bench_peers.sh [meshes (default liver_1k6,liver_4k,liver_10k)] [steps (default 1000)]
 #
-# Peer scene (../shared/peers/pypbd_liver.py): mesh units, E = 3000, nu = 0.45, rho = 1,
+# Peer scene (validation/peers/pypbd_liver.py): mesh units, E = 3000, nu = 0.45, rho = 1,
 # dt = 1 ms, top 3% fixed, gravity; pypbd: FEM-based PBD tet constraints, 5 iterations, run with
 # OMP_NUM_THREADS=1 and =2. tissuesim runs the same scene with Settings::threads 1 and 2 (cargo
 # bench --bench step -- --scene pypbd --threads N). The peer prints a mean over its steps, so the

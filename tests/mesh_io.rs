@@ -6,9 +6,11 @@ use tissuesim::math::tet_volume;
 use tissuesim::mesh::{self, lattice_box, MeshError, TetMesh};
 use tissuesim::Vec3;
 
-/// A file of the shared mesh set.
+mod common;
+
+/// A file of the test mesh set (data/meshes or `$TISSUESIM_MESHES`; panics when missing).
 fn shared(name: &str) -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name)
+    common::mesh_path(name)
 }
 
 /// A fresh scratch directory for this test.

@@ -72,7 +72,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--nu', type=float, default=0.3)
     ap.add_argument('--levels', type=int, default=2, help='uniform refinements of P1 (1 or 2)')
-    ap.add_argument('--mesh-dir', default=os.path.join(fr.REPO, '..', 'shared', 'meshes'))
+    ap.add_argument('--mesh-dir', default=fr.MESH_DIR)
     args = ap.parse_args()
     tag = 'nu%03d' % round(args.nu * 100)
     p, t, ids = fr.read_tetgen(os.path.join(args.mesh_dir, 'liver_4k'))

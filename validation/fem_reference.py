@@ -4,7 +4,7 @@
 Scenes (see validation/README.md):
   cantilever  box beam 0.1 x 0.02 x 0.02 m, clamped at x = 0, E = 5e4 Pa, nu = 0.3, rho = 1000 kg/m^3,
               gravity 9.81 m/s^2 along -y; P1 and P2 tets on a structured tet mesh, Euler-Bernoulli tip.
-  liver4k     ../shared/meshes/liver_4k (TetGen) in mesh units, E = 3000, nu in {0.3, 0.45}, rho = 1,
+  liver4k     data/meshes/liver_4k (TetGen) in mesh units, E = 3000, nu in {0.3, 0.45}, rho = 1,
               gravity 0.981 along -y, every node with y >= ymax - 0.1 (ymax - ymin) fixed; P1 and P2.
 
 Outputs go to validation/reference/: node-wise CSV `node,ux,uy,uz` (mesh's own node order) and one JSON
@@ -12,7 +12,8 @@ summary per scene. Every solve is checked: the total reaction at the fixed dofs 
 weight, and the P2 cantilever must agree with beam theory. The checks are printed and stored in the JSON.
 
 Usage:  build/venv-validation/bin/python validation/fem_reference.py [--scene cantilever|liver|all]
-                                                                     [--mesh-dir ../shared/meshes]
+                                                                     [--mesh-dir data/meshes]
+(--mesh-dir defaults to $TISSUESIM_MESHES when set, else the repository's data/meshes.)
 """
 import argparse
 import json
@@ -32,6 +33,8 @@ from skfem.models.elasticity import lame_parameters, linear_elasticity
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 OUT = os.path.join(HERE, 'reference')
+# The test meshes: $TISSUESIM_MESHES when set, else the repository's data/meshes.
+MESH_DIR = os.environ.get('TISSUESIM_MESHES') or os.path.join(REPO, 'data', 'meshes')
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -368,7 +371,7 @@ def run_liver(mesh_dir, nus=(0.3, 0.45)):
                         'the same mesh (edge midpoints added; mid-edge node fixed per p2_midedge_rule: "both-ends" = iff '
                         'both edge ends are fixed, "geometric" = iff the midpoint satisfies the y rule); '
                         'displacements reported at the original vertices in file order',
-            mesh=dict(file='liver_4k.node/.ele (../shared/meshes)', nodes=int(len(p)), tets=int(len(t)),
+            mesh=dict(file='liver_4k.node/.ele (data/meshes)', nodes=int(len(p)), tets=int(len(t)),
                       volume=float(vol.sum()), y_range=[float(ymin), float(ymax)], y_fixed_threshold=float(ythr),
                       fixed_nodes=int(fixed.sum()), p2_nodes=int(len(p) + mesh.edges.shape[1])),
             parameters=dict(E=LIVER['E'], nu=nu, rho=LIVER['rho'], g=LIVER['g'], gravity_direction=[0, -1, 0],
@@ -385,7 +388,7 @@ def main():
     global OUT, MIDEDGE_RULE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--scene', choices=['cantilever', 'liver', 'all'], default='all')
-    ap.add_argument('--mesh-dir', default=os.path.join(REPO, '..', 'shared', 'meshes'))
+    ap.add_argument('--mesh-dir', default=MESH_DIR)
     ap.add_argument('--midedge-rule', choices=['geometric', 'both-ends'], default='geometric',
                     help='P2 mid-edge node fixed iff the mid-edge point itself satisfies the fixing rule '
                          '(default) or iff both edge ends are fixed (sensitivity study)')

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Regenerate the evidence of docs/VALIDATION.md: accuracy against FEM, the paper's experiments and the probe
-# force trace. One command from a fresh clone (needs ../shared/meshes beside the repository, or
-# TISSUESIM_MESHES=/path/to/meshes):
+# force trace. One command from a fresh clone (meshes from data/meshes, or from
+# TISSUESIM_MESHES=/path/to/meshes when set):
 #
 #     validation/run_evidence.sh                 # everything, ~10-15 min on 2 cores
 #     validation/run_evidence.sh accuracy press  # only some parts (accuracy volume runtime large press), then plots

@@ -10,18 +10,36 @@ use tissuesim::{BodyId, BodyOptions, Material, Real, Settings, Vec3, World};
 /// Result type of the subcommands.
 pub type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
-/// Folder of the shared meshes: `$TISSUESIM_MESHES` or `../shared/meshes` beside the repository.
+/// Folder of the test meshes: `$TISSUESIM_MESHES` when set, else the repository's `data/meshes`.
 pub fn mesh_dir() -> PathBuf {
     match std::env::var_os("TISSUESIM_MESHES") {
         Some(p) => PathBuf::from(p),
-        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")),
+        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/data/meshes")),
     }
 }
 
-/// Load a shared TetGen mesh (`name` without extension) at `scale`, checking that the loader kept
+/// The path of the mesh file `file` in [`mesh_dir`], or an error naming the full path looked at
+/// and where the folder came from.
+pub fn mesh_path(file: &str) -> Res<PathBuf> {
+    let path = mesh_dir().join(file);
+    if path.is_file() {
+        return Ok(path);
+    }
+    let from = match std::env::var_os("TISSUESIM_MESHES") {
+        Some(dir) => format!("TISSUESIM_MESHES={}", dir.to_string_lossy()),
+        None => "TISSUESIM_MESHES is not set, so the repository's data/meshes".to_string(),
+    };
+    Err(format!(
+        "mesh not found: {} (looked there because {from})",
+        path.display()
+    )
+    .into())
+}
+
+/// Load a TetGen test mesh (`name` without extension) at `scale`, checking that the loader kept
 /// the file's node order (no unreferenced node removed), so that particle `i` is TetGen node `i`.
 pub fn load_mesh(name: &str, scale: Real) -> Res<TetMesh> {
-    let path = mesh_dir().join(format!("{name}.node"));
+    let path = mesh_path(&format!("{name}.node"))?;
     let (m, report) = mesh::load(&path, scale)?;
     let identity = report
         .original_node_index
@@ -39,7 +57,7 @@ pub fn load_mesh(name: &str, scale: Real) -> Res<TetMesh> {
     Ok(m)
 }
 
-/// The DESIGN §7 liver: a shared liver scaled by 0.03 (~0.2 m) and centred on the origin.
+/// The DESIGN §7 liver: a test liver scaled by 0.03 (~0.2 m) and centred on the origin.
 pub fn design_liver(name: &str) -> Res<TetMesh> {
     let mut m = load_mesh(name, 0.03)?;
     let (lo, hi) = m.bounding_box();

@@ -5,15 +5,43 @@ use std::path::PathBuf;
 use tissuesim::mesh::{self, TetMesh};
 use tissuesim::{BodyId, BodyOptions, Material, Real, Settings, Vec3, World};
 
-/// A mesh from the shared folder beside the repository.
-pub fn shared_mesh(file: &str) -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(file)
+/// The folder of the test meshes: `$TISSUESIM_MESHES` when set, else `data/meshes` in the
+/// repository (see data/meshes/README.md).
+pub fn mesh_dir() -> PathBuf {
+    match std::env::var_os("TISSUESIM_MESHES") {
+        Some(dir) => PathBuf::from(dir),
+        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/data/meshes")),
+    }
 }
 
-/// A shared liver mesh scaled by 0.03 (about 0.19 × 0.15 × 0.13 m) and translated so that its
-/// bounding box is centred on the origin.
+/// The path of the test mesh `file` in [`mesh_dir`] (a file name, or a TetGen base name without
+/// `.node`/`.ele`). Panics, naming the full path looked at and the environment variable, when the
+/// file is not there: a test never skips for missing data.
+pub fn mesh_path(file: &str) -> PathBuf {
+    let path = mesh_dir().join(file);
+    let tetgen_base = || {
+        let mut node = path.clone().into_os_string();
+        node.push(".node");
+        PathBuf::from(node).is_file()
+    };
+    if !path.is_file() && !tetgen_base() {
+        let from = match std::env::var_os("TISSUESIM_MESHES") {
+            Some(dir) => format!("TISSUESIM_MESHES={}", dir.to_string_lossy()),
+            None => "TISSUESIM_MESHES is not set, so the repository's data/meshes".to_string(),
+        };
+        panic!(
+            "test mesh not found: {} (looked there because {from}; set TISSUESIM_MESHES to a \
+             folder holding the files of data/meshes/README.md)",
+            path.display()
+        );
+    }
+    path
+}
+
+/// A liver mesh of [`mesh_dir`] scaled by 0.03 (about 0.19 × 0.15 × 0.13 m) and translated so
+/// that its bounding box is centred on the origin.
 pub fn liver(file: &str) -> TetMesh {
-    let mut mesh = mesh::load(&shared_mesh(file), 0.03)
+    let mut mesh = mesh::load(&mesh_path(file), 0.03)
         .unwrap_or_else(|e| panic!("{e}"))
         .0;
     let (lo, hi) = mesh.bounding_box();
