@@ -1,7 +1,7 @@
 # CMake package configuration for the tissuesim C API, installed by cmake/install.sh to
 # PREFIX/lib/cmake/tissuesim/. Use:
 #
-#   find_package(tissuesim 0.1 REQUIRED)            # CMAKE_PREFIX_PATH=PREFIX
+#   find_package(tissuesim 0.1 CONFIG REQUIRED)     # CMAKE_PREFIX_PATH=PREFIX
 #   target_link_libraries(app PRIVATE tissuesim::tissuesim)         # shared
 #   target_link_libraries(app PRIVATE tissuesim::tissuesim_static)  # static
 #
@@ -9,6 +9,20 @@
 # Rust's standard library uses (pthread, dl, m), which tissuesim::tissuesim_static brings.
 
 get_filename_component(_tissuesim_prefix "${CMAKE_CURRENT_LIST_DIR}/../../.." ABSOLUTE)
+
+# A prefix without the header or the shared library is not a tissuesim installation: say so
+# rather than define a target that fails at link time.
+foreach(_tissuesim_file include/tissuesim.h lib/libtissuesim.so)
+  if(NOT EXISTS "${_tissuesim_prefix}/${_tissuesim_file}")
+    set(tissuesim_FOUND FALSE)
+    set(tissuesim_NOT_FOUND_MESSAGE
+        "${_tissuesim_prefix}/${_tissuesim_file} is missing (install with cmake/install.sh PREFIX)")
+    unset(_tissuesim_file)
+    unset(_tissuesim_prefix)
+    return()
+  endif()
+endforeach()
+unset(_tissuesim_file)
 
 if(NOT TARGET tissuesim::tissuesim)
   add_library(tissuesim::tissuesim SHARED IMPORTED)
