@@ -157,7 +157,14 @@ pub fn write_vtu(
 /// 1.4 × 10⁻³ m³ (1.4 L) and a bounding box of about [-0.108, 0.103] × [-0.045, 0.058] ×
 /// [-0.068, 0.068] m (x left–right, y up, z front–back). Every call returns the same bits.
 pub fn default_organ() -> TetMesh {
-    organ::build_default_organ()
+    organ::build_organ(organ::DEFAULT_CELL)
+}
+
+/// The default organ's shape tetrahedralised on a lattice of cubes of edge `cell` (m), for
+/// convergence studies: `organ_with_cell(0.0095)` is [`default_organ`]; halving `cell`
+/// gives about eight times the nodes. `cell` is clamped to [0.003, 0.05] m.
+pub fn organ_with_cell(cell: Real) -> TetMesh {
+    organ::build_organ(cell.clamp(0.003, 0.05))
 }
 
 impl TetMesh {

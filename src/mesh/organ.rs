@@ -9,12 +9,18 @@ use super::TetMesh;
 use crate::math::{tet_volume, Real, Vec3};
 use std::path::Path;
 
-/// Edge length of the lattice cells (m).
-const CELL: Real = 0.0095;
+/// Edge length of the lattice cells of the default organ (m).
+pub(crate) const DEFAULT_CELL: Real = 0.0095;
 /// Lower corner of the lattice (m); it covers the whole implicit solid.
 const GRID_MIN: [Real; 3] = [-0.125, -0.085, -0.095];
-/// Number of cells of the lattice along x, y, z.
-const GRID_CELLS: [usize; 3] = [27, 18, 20];
+/// Extent of the lattice along x, y, z (m): 27, 18 and 20 cells of the default size.
+const GRID_EXTENT: [Real; 3] = [0.2565, 0.171, 0.19];
+
+/// Number of lattice cells along x, y, z for cells of edge `cell` (m): enough to cover
+/// [`GRID_EXTENT`] (27 × 18 × 20 at the default size).
+fn grid_cells(cell: Real) -> [usize; 3] {
+    GRID_EXTENT.map(|e| ((e / cell) - 1e-6).ceil().max(1.0) as usize)
+}
 /// Passes of boundary-node snapping.
 const SNAP_PASSES: usize = 8;
 /// A snapping move is rejected if a tetrahedron would fall below this fraction of its lattice
@@ -97,14 +103,14 @@ fn organ_gradient(p: &Vec3) -> Vec3 {
 
 /// Which lattice cells belong to the organ: centre inside the implicit solid, then small
 /// clean-ups so that the cell set is one face-connected piece without edge-only contacts.
-fn organ_cells() -> Vec<bool> {
-    let [nx, ny, nz] = GRID_CELLS;
+fn organ_cells(cell: Real) -> Vec<bool> {
+    let [nx, ny, nz] = grid_cells(cell);
     let idx = |i: usize, j: usize, k: usize| i + nx * (j + ny * k);
     let centre = |i: usize, j: usize, k: usize| {
         Vec3::new(
-            GRID_MIN[0] + (i as Real + 0.5) * CELL,
-            GRID_MIN[1] + (j as Real + 0.5) * CELL,
-            GRID_MIN[2] + (k as Real + 0.5) * CELL,
+            GRID_MIN[0] + (i as Real + 0.5) * cell,
+            GRID_MIN[1] + (j as Real + 0.5) * cell,
+            GRID_MIN[2] + (k as Real + 0.5) * cell,
         )
     };
     let mut full = vec![false; nx * ny * nz];
@@ -238,10 +244,11 @@ fn organ_cells() -> Vec<bool> {
     label.iter().map(|&l| l == best.1).collect()
 }
 
-/// Build the default organ (see [`default_organ`](super::default_organ)).
-pub(crate) fn build_default_organ() -> TetMesh {
-    let [nx, ny, nz] = GRID_CELLS;
-    let cells = organ_cells();
+/// Build the organ on a lattice of cells of edge `cell` (m) (see
+/// [`organ_with_cell`](super::organ_with_cell)).
+pub(crate) fn build_organ(cell: Real) -> TetMesh {
+    let [nx, ny, nz] = grid_cells(cell);
+    let cells = organ_cells(cell);
     let (px, py) = (nx + 1, ny + 1);
     let node_index = |i: usize, j: usize, k: usize| (i + px * (j + py * k)) as u32;
     let mut nodes = Vec::with_capacity(px * py * (nz + 1));
@@ -249,9 +256,9 @@ pub(crate) fn build_default_organ() -> TetMesh {
         for j in 0..=ny {
             for i in 0..=nx {
                 nodes.push(Vec3::new(
-                    GRID_MIN[0] + i as Real * CELL,
-                    GRID_MIN[1] + j as Real * CELL,
-                    GRID_MIN[2] + k as Real * CELL,
+                    GRID_MIN[0] + i as Real * cell,
+                    GRID_MIN[1] + j as Real * cell,
+                    GRID_MIN[2] + k as Real * cell,
                 ));
             }
         }
@@ -274,13 +281,13 @@ pub(crate) fn build_default_organ() -> TetMesh {
     // Drop the lattice nodes outside the organ; the lattice is valid by construction.
     let (mut mesh, _) = TetMesh::from_raw(nodes, tets, Path::new("<default organ>"))
         .expect("the default organ lattice is a valid mesh");
-    snap_boundary(&mut mesh);
+    snap_boundary(&mut mesh, cell);
     mesh
 }
 
 /// Pull the boundary nodes onto the implicit surface, a fraction of the way per pass,
 /// accepting a move only if every tetrahedron around the node keeps a healthy volume.
-fn snap_boundary(mesh: &mut TetMesh) {
+fn snap_boundary(mesh: &mut TetMesh, cell: Real) {
     let n = mesh.nodes.len();
     let mut on_boundary = vec![false; n];
     for t in mesh.boundary_triangles() {
@@ -306,7 +313,7 @@ fn snap_boundary(mesh: &mut TetMesh) {
             fill[i as usize] += 1;
         }
     }
-    let min_volume = MIN_VOLUME_FRACTION * CELL * CELL * CELL / 6.0;
+    let min_volume = MIN_VOLUME_FRACTION * cell * cell * cell / 6.0;
     let volume_ok = |nodes: &[Vec3], node: usize, tets: &[[u32; 4]]| {
         around[start[node]..start[node + 1]].iter().all(|&ti| {
             let t = tets[ti as usize];
@@ -360,7 +367,7 @@ fn snap_boundary(mesh: &mut TetMesh) {
             }
             let mut step = -g * (f / g2) * fraction;
             // Never move more than half a cell in one go.
-            let limit = 0.5 * CELL;
+            let limit = 0.5 * cell;
             if step.norm() > limit {
                 step *= limit / step.norm();
             }
@@ -396,13 +403,25 @@ mod tests {
     }
 
     #[test]
+    fn default_lattice_is_27_by_18_by_20() {
+        assert_eq!(grid_cells(DEFAULT_CELL), [27, 18, 20]);
+    }
+
+    #[test]
+    fn finer_cells_give_more_nodes() {
+        let coarse = build_organ(1.4 * DEFAULT_CELL).nodes.len();
+        let fine = build_organ(0.8 * DEFAULT_CELL).nodes.len();
+        assert!(fine > coarse * 3, "{coarse} -> {fine}");
+    }
+
+    #[test]
     fn lattice_covers_the_solid() {
         // No part of the solid touches the lattice border.
-        let [nx, ny, nz] = GRID_CELLS;
+        let [nx, ny, nz] = grid_cells(DEFAULT_CELL);
         let hi = [
-            GRID_MIN[0] + nx as Real * CELL,
-            GRID_MIN[1] + ny as Real * CELL,
-            GRID_MIN[2] + nz as Real * CELL,
+            GRID_MIN[0] + nx as Real * DEFAULT_CELL,
+            GRID_MIN[1] + ny as Real * DEFAULT_CELL,
+            GRID_MIN[2] + nz as Real * DEFAULT_CELL,
         ];
         let steps = 40;
         for a in 0..=steps {
