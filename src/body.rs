@@ -1,6 +1,7 @@
 //! A deformable body: particles at the mesh nodes, their neighbourhoods with the rest-state
 //! quantities precomputed, the tetrahedra for volume conservation, and the material.
 
+use crate::consistency;
 use crate::elastic::{self, ElasticModel, ForceInputs};
 use crate::error::Error;
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
@@ -56,6 +57,12 @@ pub struct BodyOptions {
     pub target_neighbours: u32,
     /// Contact radius of the particles (m); `None` derives it from the particle spacing.
     pub particle_radius: Option<Real>,
+    /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
+    /// divergence theorem (variationally consistent integration, [`crate::consistency`]): a
+    /// uniform stress then leaves interior particles in equilibrium on any point set, and the
+    /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
+    /// gradients of the paper (for comparison only).
+    pub consistent_gradients: bool,
 }
 
 impl Default for BodyOptions {
@@ -65,6 +72,7 @@ impl Default for BodyOptions {
             support_radius: None,
             target_neighbours: 20,
             particle_radius: None,
+            consistent_gradients: true,
         }
     }
 }
@@ -115,6 +123,8 @@ pub struct Body {
     /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
     /// split) disables them.
     pub(crate) volume_compliance: Real,
+    /// Whether the world projects the volume constraints (`Settings::volume_constraints`).
+    pub(crate) volume_constraints_on: bool,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
     /// Copies of `x`, `v`, `rotation` taken at the start of a step, restored if it diverges.
@@ -191,7 +201,11 @@ impl Body {
                 target: options.target_neighbours as usize,
             },
         };
-        let nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
+        let mut nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
+        let boundary = mesh.boundary_triangles();
+        if options.consistent_gradients {
+            consistency::correct_gradients(&mut nbr, &mesh.nodes, &particle_volume, &boundary);
+        }
         let mass: Vec<Real> = particle_volume.iter().map(|v| v * m.density).collect();
         let particle_radius = options
             .particle_radius
@@ -217,10 +231,11 @@ impl Body {
             tet_lambda: vec![0.0; mesh.tets.len()],
             tet_rest_volume,
             tets: mesh.tets.clone(),
-            boundary: mesh.boundary_triangles(),
+            boundary,
             particle_radius,
             omega_max: 0.0,
             volume_compliance: 0.0,
+            volume_constraints_on: false,
             saved_x: mesh.nodes.clone(),
             saved_v: vec![Vec3::zeros(); n],
             saved_rotation: vec![Quat::identity(); n],
@@ -360,6 +375,7 @@ impl Body {
             settings.damping_stiffness,
         );
         self.volume_compliance = settings.volume_compliance;
+        self.volume_constraints_on = settings.volume_constraints;
         if settings.volume_constraints && settings.volumetric_split {
             self.volume_compliance += 1.0 / self.model.lambda;
             self.model.lambda = 0.0;

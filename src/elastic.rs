@@ -17,7 +17,7 @@
 //!
 //! Hourglass control (in the spirit of Ganzenmüller 2015): the part of a pair's current offset
 //! that `F_i` does not explain, `ε_ij = F_i u_ij - x_ij`, is penalised by the energy
-//! `Σ_i Σ_j c_ij |ε_ij|² / 2` with `c_ij = c_hg E v_i ŵ_ij / |u_ij|²` (N/m), `ŵ` the normalised
+//! `Σ_i Σ_j c_ij |ε_ij|² / 2` with `c_ij = c_hg μ v_i ŵ_ij / |u_ij|²` (N/m), `ŵ` the normalised
 //! kernel weight. `ε` is linear in the positions (through `F_i`), zero under any affine motion
 //! and rotation invariant in norm, so its exact gradient is a conservative force that conserves
 //! linear and angular momentum and never pumps energy into the zero-energy modes it removes.
@@ -38,7 +38,7 @@ pub struct ElasticModel {
     pub lambda: Real,
     /// Shear modulus μ (Pa).
     pub mu: Real,
-    /// Hourglass stiffness `c_hg · E` (Pa).
+    /// Hourglass stiffness `c_hg · μ` (Pa).
     pub hourglass: Real,
     /// Stiffness-proportional damping time β (s).
     pub damping_stiffness: Real,
@@ -51,7 +51,7 @@ impl ElasticModel {
         ElasticModel {
             lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
             mu: e / (2.0 * (1.0 + nu)),
-            hourglass: c_hg * e,
+            hourglass: c_hg * e / (2.0 * (1.0 + nu)),
             damping_stiffness: beta,
         }
     }

@@ -26,6 +26,7 @@
 
 pub mod body;
 pub mod collision;
+pub mod consistency;
 pub mod constraints;
 pub mod elastic;
 pub mod error;
@@ -37,6 +38,7 @@ pub mod parallel;
 pub mod settings;
 pub mod stability;
 pub mod state;
+pub mod statics;
 pub mod world;
 
 pub use body::{Body, BodyOptions, Material};

@@ -318,6 +318,24 @@ impl World {
         }
     }
 
+    /// Move every body to its static equilibrium under gravity with its fixed particles held,
+    /// and set every velocity to zero: a scene that starts from `settle()` is at rest instead
+    /// of swinging into place. Tools and organ–organ contacts are not considered (settle
+    /// before the tools touch the tissue). One report per body, in body order.
+    ///
+    /// Fails without changing anything for a body with no fixed particle (a free body has no
+    /// static equilibrium under gravity).
+    pub fn settle(&mut self) -> Result<Vec<crate::statics::SettleReport>, Error> {
+        let g = self.settings.gravity;
+        let mut settled = self.bodies.clone();
+        let mut reports = Vec::with_capacity(settled.len());
+        for body in &mut settled {
+            reports.push(crate::statics::settle_body(body, g)?);
+        }
+        self.bodies = settled;
+        Ok(reports)
+    }
+
     /// Advance the world by `settings.dt`. On NaN/Inf the world is rolled back and
     /// [`Error::Diverged`] returned.
     pub fn step(&mut self) -> Result<StepReport, Error> {

@@ -1,0 +1,422 @@
+//! Static equilibrium of a body: the stiffness of its discrete energy at rest, assembled as a
+//! sparse matrix and factorised once (sparse Cholesky, faer), used for
+//!
+//! - the linear (small-strain) static response `K u = f` that the validation compares with FEM;
+//! - [`World::settle`](crate::World::settle): the nonlinear equilibrium under gravity, by
+//!   modified Newton iterations `K Δx = r(x)` on the rest stiffness with a backtracking line
+//!   search on the residual, so a scene can start at rest instead of swinging into place.
+//!
+//! The energy is the one the step integrates: the point-based corotated elasticity
+//! `Σ_i v_i Ψ(F_i)`, the hourglass term, and — when the volume constraints carry the
+//! volumetric stiffness — each tetrahedron's `(V − V₀)² / (2 α V₀)` with `α` the constraints'
+//! compliance per unit volume (1/Pa). Tools and organ–organ contacts are not part of it.
+
+use crate::body::Body;
+use crate::error::Error;
+use crate::math::{Mat3, Real, Vec3};
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Side};
+
+/// A symmetric 3×3-block sparse matrix in block-row (CSR) form, one block row per particle.
+pub(crate) struct BlockMatrix {
+    offsets: Vec<usize>,
+    columns: Vec<u32>,
+    blocks: Vec<Mat3>,
+}
+
+impl BlockMatrix {
+    /// The pattern holding every block `(k, l)` with `k` and `l` in a common stencil.
+    fn from_stencils<'a>(n: usize, stencils: impl Iterator<Item = &'a [u32]> + Clone) -> Self {
+        let mut rows: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for s in stencils {
+            for &k in s {
+                rows[k as usize].extend_from_slice(s);
+            }
+        }
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut columns = Vec::new();
+        offsets.push(0);
+        for mut r in rows {
+            r.sort_unstable();
+            r.dedup();
+            columns.extend_from_slice(&r);
+            offsets.push(columns.len());
+        }
+        let blocks = vec![Mat3::zeros(); columns.len()];
+        BlockMatrix {
+            offsets,
+            columns,
+            blocks,
+        }
+    }
+
+    fn add(&mut self, row: u32, column: u32, block: &Mat3) {
+        let r = row as usize;
+        let cols = &self.columns[self.offsets[r]..self.offsets[r + 1]];
+        let k = cols
+            .binary_search(&column)
+            .expect("block inside the assembled pattern");
+        self.blocks[self.offsets[r] + k] += block;
+    }
+
+    /// `y = K x` (N for x in m).
+    pub(crate) fn mul(&self, x: &[Vec3], y: &mut [Vec3]) {
+        for (r, yr) in y.iter_mut().enumerate() {
+            let mut s = Vec3::zeros();
+            for e in self.offsets[r]..self.offsets[r + 1] {
+                s += self.blocks[e] * x[self.columns[e] as usize];
+            }
+            *yr = s;
+        }
+    }
+}
+
+/// The stiffness (N/m) of `body`'s discrete energy at its rest positions.
+pub(crate) fn rest_stiffness(body: &Body) -> BlockMatrix {
+    let nbr = &body.nbr;
+    let n = body.particle_count();
+    // Stencil of particle i: itself, then its neighbours.
+    let stencils: Vec<Vec<u32>> = (0..n)
+        .map(|i| {
+            let mut s = vec![i as u32];
+            s.extend_from_slice(&nbr.index[nbr.range(i)]);
+            s
+        })
+        .collect();
+    let volume_stiffness = volume_stiffness_per_unit_volume(body);
+    let tets: Vec<Vec<u32>> = if volume_stiffness > 0.0 {
+        body.tets.iter().map(|t| t.to_vec()).collect()
+    } else {
+        Vec::new()
+    };
+    let mut k = BlockMatrix::from_stencils(
+        n,
+        stencils
+            .iter()
+            .map(Vec::as_slice)
+            .chain(tets.iter().map(Vec::as_slice)),
+    );
+    let (lambda, mu, hourglass) = (body.model.lambda, body.model.mu, body.model.hourglass);
+    let mut c = Vec::new();
+    let mut a = Vec::new();
+    for (i, stencil) in stencils.iter().enumerate() {
+        let vi = body.particle_volume[i];
+        let range = nbr.range(i);
+        // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
+        c.clear();
+        c.push(-nbr.gradient[range.clone()].iter().sum::<Vec3>());
+        c.extend_from_slice(&nbr.gradient[range.clone()]);
+        // Linear elasticity: K_kl = v_i [μ (c_k·c_l) I + μ c_l c_kᵀ + λ c_k c_lᵀ].
+        for (p, ck) in c.iter().enumerate() {
+            for (q, cl) in c.iter().enumerate() {
+                let block = Mat3::identity() * (mu * ck.dot(cl))
+                    + cl * ck.transpose() * mu
+                    + ck * cl.transpose() * lambda;
+                k.add(stencil[p], stencil[q], &(block * vi));
+            }
+        }
+        // Hourglass: ½ c_ij |ε_ij|², ε_ij = Σ_k a_k x_k with a_k = c_k·u_ij − δ_kj + δ_ki.
+        if hourglass != 0.0 {
+            for (slot, e) in range.enumerate() {
+                let u = nbr.rest_offset[e];
+                let cij = hourglass * vi * nbr.hourglass_weight[e];
+                a.clear();
+                a.extend(c.iter().map(|ck| ck.dot(&u)));
+                a[0] += 1.0;
+                a[slot + 1] -= 1.0;
+                for (p, ap) in a.iter().enumerate() {
+                    for (q, aq) in a.iter().enumerate() {
+                        k.add(
+                            stencil[p],
+                            stencil[q],
+                            &(Mat3::identity() * (cij * ap * aq)),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    if volume_stiffness > 0.0 {
+        for (t, tet) in body.tets.iter().enumerate() {
+            let g = volume_gradient(&body.rest, tet);
+            let kt = volume_stiffness / body.tet_rest_volume[t];
+            for p in 0..4 {
+                for q in 0..4 {
+                    k.add(tet[p], tet[q], &(g[p] * g[q].transpose() * kt));
+                }
+            }
+        }
+    }
+    k
+}
+
+/// Stiffness per unit volume (Pa) of the tetrahedron volume constraints, `1/α`; 0 when they
+/// are off or infinitely compliant.
+fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
+    let alpha = body.volume_compliance;
+    if body.volume_constraints_on && alpha.is_finite() && alpha > 0.0 {
+        1.0 / alpha
+    } else {
+        0.0
+    }
+}
+
+/// Gradients (m²) of a tetrahedron's signed volume with respect to its four corners.
+fn volume_gradient(x: &[Vec3], tet: &[u32; 4]) -> [Vec3; 4] {
+    let [a, b, c, d] = tet.map(|k| x[k as usize]);
+    let gb = (c - a).cross(&(d - a)) / 6.0;
+    let gc = (d - a).cross(&(b - a)) / 6.0;
+    let gd = (b - a).cross(&(c - a)) / 6.0;
+    [-(gb + gc + gd), gb, gc, gd]
+}
+
+/// The forces (N) of the volume energy at positions `x` (m), added to `force`.
+fn add_volume_forces(body: &Body, x: &[Vec3], force: &mut [Vec3]) {
+    let stiffness = volume_stiffness_per_unit_volume(body);
+    if stiffness == 0.0 {
+        return;
+    }
+    for (t, tet) in body.tets.iter().enumerate() {
+        let v0 = body.tet_rest_volume[t];
+        let g = volume_gradient(x, tet);
+        let [a, b, c, d] = tet.map(|k| x[k as usize]);
+        let violation = crate::math::tet_volume(&a, &b, &c, &d) - v0;
+        let scale = -stiffness * violation / v0;
+        for p in 0..4 {
+            force[tet[p] as usize] += g[p] * scale;
+        }
+    }
+}
+
+/// The rest stiffness restricted to the free particles, factorised.
+pub(crate) struct FactorisedStiffness {
+    /// Free particle → dof block (`u32::MAX` for fixed particles).
+    dof: Vec<u32>,
+    free: usize,
+    llt: faer::sparse::linalg::solvers::Llt<usize, Real>,
+    /// The unrestricted matrix, for residual checks.
+    pub(crate) matrix: BlockMatrix,
+}
+
+impl FactorisedStiffness {
+    /// Assemble and factorise `body`'s rest stiffness with its fixed particles removed.
+    pub(crate) fn new(body: &Body) -> Result<Self, Error> {
+        let matrix = rest_stiffness(body);
+        let n = body.particle_count();
+        let mut dof = vec![u32::MAX; n];
+        let mut free = 0;
+        for (d, fixed) in dof.iter_mut().zip(&body.fixed) {
+            if !fixed {
+                *d = free as u32;
+                free += 1;
+            }
+        }
+        if free == 0 {
+            return Err(Error::InvalidArgument(
+                "every particle is fixed: nothing to solve".into(),
+            ));
+        }
+        let mut triplets = Vec::new();
+        for r in 0..n {
+            let dr = dof[r];
+            if dr == u32::MAX {
+                continue;
+            }
+            for e in matrix.offsets[r]..matrix.offsets[r + 1] {
+                let dc = dof[matrix.columns[e] as usize];
+                if dc == u32::MAX || dc > dr {
+                    continue;
+                }
+                let block = &matrix.blocks[e];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let (row, col) = (3 * dr as usize + a, 3 * dc as usize + b);
+                        if col <= row {
+                            triplets.push(Triplet::new(row, col, block[(a, b)]));
+                        }
+                    }
+                }
+            }
+        }
+        let m = 3 * free;
+        let sparse = SparseColMat::<usize, Real>::try_new_from_triplets(m, m, &triplets)
+            .map_err(|e| Error::InvalidArgument(format!("stiffness assembly: {e:?}")))?;
+        let llt = sparse.sp_cholesky(Side::Lower).map_err(|_| {
+            Error::InvalidArgument(
+                "the body's stiffness is singular: fix enough particles to hold it \
+                 (a free body has no static equilibrium under gravity)"
+                    .into(),
+            )
+        })?;
+        Ok(FactorisedStiffness {
+            dof,
+            free,
+            llt,
+            matrix,
+        })
+    }
+
+    /// Solve `K Δx = r` on the free particles (`r` in N, `Δx` in m; fixed particles get 0).
+    pub(crate) fn solve(&self, r: &[Vec3], dx: &mut [Vec3]) {
+        let mut rhs = Mat::<Real>::zeros(3 * self.free, 1);
+        for (i, d) in self.dof.iter().enumerate() {
+            if *d != u32::MAX {
+                for a in 0..3 {
+                    rhs[(3 * *d as usize + a, 0)] = r[i][a];
+                }
+            }
+        }
+        self.llt.solve_in_place(rhs.as_mut());
+        for (i, d) in self.dof.iter().enumerate() {
+            dx[i] = if *d == u32::MAX {
+                Vec3::zeros()
+            } else {
+                let k = 3 * *d as usize;
+                Vec3::new(rhs[(k, 0)], rhs[(k + 1, 0)], rhs[(k + 2, 0)])
+            };
+        }
+    }
+}
+
+/// The linear (small-strain) static displacement (m) of `body` from its rest state: the
+/// solution of `K u = load` on the free particles, with `u = prescribed` on the fixed ones
+/// (`load` in N and `prescribed` in m, one entry per particle; `prescribed` is read only at
+/// fixed particles). `K` is the stiffness of the body's discrete energy at rest.
+pub fn linear_response(
+    body: &Body,
+    load: &[Vec3],
+    prescribed: &[Vec3],
+) -> Result<Vec<Vec3>, Error> {
+    let n = body.particle_count();
+    if load.len() != n || prescribed.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "linear_response: {n} particles, got {} loads and {} prescribed displacements",
+            load.len(),
+            prescribed.len()
+        )));
+    }
+    let k = FactorisedStiffness::new(body)?;
+    // Move the prescribed displacements to the right-hand side: f − K u_b.
+    let boundary: Vec<Vec3> = (0..n)
+        .map(|i| {
+            if body.fixed[i] {
+                prescribed[i]
+            } else {
+                Vec3::zeros()
+            }
+        })
+        .collect();
+    let mut ku = vec![Vec3::zeros(); n];
+    k.matrix.mul(&boundary, &mut ku);
+    let rhs: Vec<Vec3> = load.iter().zip(&ku).map(|(f, k)| f - k).collect();
+    let mut u = vec![Vec3::zeros(); n];
+    k.solve(&rhs, &mut u);
+    for i in 0..n {
+        if body.fixed[i] {
+            u[i] = prescribed[i];
+        }
+    }
+    Ok(u)
+}
+
+/// The linear (small-strain) static displacement (m) of `body` under gravity `g` (m/s²), its
+/// fixed particles held at rest: `K u = m g`.
+pub fn linear_gravity_sag(body: &Body, g: Vec3) -> Result<Vec<Vec3>, Error> {
+    let load: Vec<Vec3> = body.mass.iter().map(|m| g * *m).collect();
+    linear_response(body, &load, &vec![Vec3::zeros(); body.particle_count()])
+}
+
+/// Outcome of a nonlinear static solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SettleReport {
+    /// Modified-Newton iterations used.
+    pub iterations: u32,
+    /// Largest force residual on a free particle at the end, relative to the largest particle
+    /// weight (dimensionless).
+    pub relative_residual: Real,
+    /// True when the residual reached the tolerance.
+    pub converged: bool,
+}
+
+/// Relative force residual at which [`settle_body`] stops.
+pub const SETTLE_TOLERANCE: Real = 1.0e-9;
+/// Largest number of modified-Newton iterations of [`settle_body`].
+pub const SETTLE_MAX_ITERATIONS: u32 = 200;
+
+/// The force residual (N) of `body` at positions `x` (m) under gravity `g`: elastic, hourglass
+/// and volume forces plus the weight; zero on fixed particles.
+fn residual(body: &Body, x: &[Vec3], g: Vec3) -> Vec<Vec3> {
+    let mut r = body.elastic_forces_at(x);
+    add_volume_forces(body, x, &mut r);
+    for (i, ri) in r.iter_mut().enumerate() {
+        if body.fixed[i] {
+            *ri = Vec3::zeros();
+        } else {
+            *ri += g * body.mass[i];
+        }
+    }
+    r
+}
+
+fn max_norm(v: &[Vec3]) -> Real {
+    v.iter().map(|x| x.norm()).fold(0.0, Real::max)
+}
+
+/// Move `body`'s free particles to their static equilibrium under gravity `g` (m/s²), from
+/// their current positions; velocities are set to zero. Returns the iterations and residual.
+pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Error> {
+    let k = FactorisedStiffness::new(body)?;
+    let weight = body
+        .mass
+        .iter()
+        .map(|m| (g * *m).norm())
+        .fold(0.0, Real::max)
+        .max(Real::MIN_POSITIVE);
+    let mut x = body.x.clone();
+    let mut r = residual(body, &x, g);
+    let mut res = max_norm(&r) / weight;
+    let mut dx = vec![Vec3::zeros(); x.len()];
+    let mut iterations = 0;
+    while res > SETTLE_TOLERANCE && iterations < SETTLE_MAX_ITERATIONS {
+        iterations += 1;
+        k.solve(&r, &mut dx);
+        // Backtrack while the residual grows (large rotations make the rest stiffness a poor
+        // model); accept the smallest step tried otherwise.
+        let mut step = 1.0;
+        let (mut x_try, mut r_try, mut res_try);
+        loop {
+            x_try = x
+                .iter()
+                .zip(&dx)
+                .map(|(x, d)| x + d * step)
+                .collect::<Vec<_>>();
+            r_try = residual(body, &x_try, g);
+            res_try = max_norm(&r_try) / weight;
+            if res_try < res || step < 1.0 / 64.0 || !res_try.is_finite() {
+                break;
+            }
+            step *= 0.5;
+        }
+        if !res_try.is_finite() {
+            return Err(Error::Diverged(
+                "settle: the static solve produced non-finite positions".into(),
+            ));
+        }
+        x = x_try;
+        r = r_try;
+        res = res_try;
+    }
+    body.x.copy_from_slice(&x);
+    body.p.copy_from_slice(&x);
+    body.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+    for i in 0..x.len() {
+        let f = crate::elastic::deformation_gradient(&body.nbr, &x, i);
+        body.rotation[i] = crate::elastic::rotation_from_svd(&f);
+    }
+    Ok(SettleReport {
+        iterations,
+        relative_residual: res,
+        converged: res <= SETTLE_TOLERANCE,
+    })
+}
