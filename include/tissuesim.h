@@ -430,6 +430,21 @@ enum ts_status ts_world_set_settings(struct ts_world *world, const struct ts_set
 enum ts_status ts_world_step(struct ts_world *world, struct ts_step_report *out_report);
 
 /**
+ * Move every body to its static equilibrium under gravity, fixed particles held, velocities
+ * zero: start a scene at rest instead of letting it swing into place (Newton iterations with
+ * the corotated stiffness and a sparse direct factorisation, gravity in increments; tools
+ * and organ contacts are ignored, so settle before a tool touches the tissue). Reliable for
+ * moderate sags; a sag of several centimetres on a 0.2 m organ may not converge yet (the
+ * positions reached are kept). Fails with TS_STATUS_INVALID_ARGUMENT and changes nothing
+ * when a body has no fixed particle. Allocates: not for the haptic loop.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_settle(struct ts_world *world);
+
+/**
  * Simulated time (s) since the world was created (or of the last restored state).
  *
  * # Safety

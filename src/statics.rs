@@ -3,8 +3,9 @@
 //!
 //! - the linear (small-strain) static response `K u = f` that the validation compares with FEM;
 //! - [`World::settle`](crate::World::settle): the nonlinear equilibrium under gravity, by
-//!   modified Newton iterations `K Δx = r(x)` on the rest stiffness with a backtracking line
-//!   search on the residual, so a scene can start at rest instead of swinging into place.
+//!   Newton-like iterations `K(x) Δx = r(x)` with the corotated (warped) stiffness `K(x)` and
+//!   a backtracking line search on the residual, so a scene can start at rest instead of
+//!   swinging into place.
 //!
 //! The energy is the one the step integrates: the point-based corotated elasticity
 //! `Σ_i v_i Ψ(F_i)`, the hourglass term, and — when the volume constraints carry the
@@ -72,8 +73,11 @@ impl BlockMatrix {
     }
 }
 
-/// The stiffness (N/m) of `body`'s discrete energy at its rest positions.
-pub(crate) fn rest_stiffness(body: &Body) -> BlockMatrix {
+/// The stiffness (N/m) of `body`'s discrete energy at its rest positions (`at = None`), or
+/// its corotated approximation at positions `at` (m): each particle's elastic and hourglass
+/// blocks rotated by the particle's rotation `R_i` (`R_i K_i R_iᵀ`, stiffness warping) and
+/// the volume terms taken with the current tetrahedron gradients (Gauss–Newton).
+pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     let nbr = &body.nbr;
     let n = body.particle_count();
     // Stencil of particle i: itself, then its neighbours.
@@ -100,8 +104,20 @@ pub(crate) fn rest_stiffness(body: &Body) -> BlockMatrix {
     let (lambda, mu, hourglass) = (body.model.lambda, body.model.mu, body.model.hourglass);
     let mut c = Vec::new();
     let mut a = Vec::new();
+    let rotations: Vec<Mat3> = match at {
+        Some(x) => (0..n)
+            .map(|i| {
+                let f = crate::elastic::deformation_gradient(nbr, x, i);
+                crate::elastic::rotation_from_svd(&f)
+                    .to_rotation_matrix()
+                    .into_inner()
+            })
+            .collect(),
+        None => vec![Mat3::identity(); n],
+    };
     for (i, stencil) in stencils.iter().enumerate() {
         let vi = body.particle_volume[i];
+        let (r, rt) = (rotations[i], rotations[i].transpose());
         let range = nbr.range(i);
         // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
         c.clear();
@@ -113,7 +129,7 @@ pub(crate) fn rest_stiffness(body: &Body) -> BlockMatrix {
                 let block = Mat3::identity() * (mu * ck.dot(cl))
                     + cl * ck.transpose() * mu
                     + ck * cl.transpose() * lambda;
-                k.add(stencil[p], stencil[q], &(block * vi));
+                k.add(stencil[p], stencil[q], &(r * block * rt * vi));
             }
         }
         // Hourglass: ½ c_ij |ε_ij|², ε_ij = Σ_k a_k x_k with a_k = c_k·u_ij − δ_kj + δ_ki.
@@ -139,7 +155,7 @@ pub(crate) fn rest_stiffness(body: &Body) -> BlockMatrix {
     }
     if volume_stiffness > 0.0 {
         for (t, tet) in body.tets.iter().enumerate() {
-            let g = volume_gradient(&body.rest, tet);
+            let g = volume_gradient(at.unwrap_or(&body.rest), tet);
             let kt = volume_stiffness / body.tet_rest_volume[t];
             for p in 0..4 {
                 for q in 0..4 {
@@ -201,8 +217,8 @@ pub(crate) struct FactorisedStiffness {
 
 impl FactorisedStiffness {
     /// Assemble and factorise `body`'s rest stiffness with its fixed particles removed.
-    pub(crate) fn new(body: &Body) -> Result<Self, Error> {
-        let matrix = rest_stiffness(body);
+    pub(crate) fn new(body: &Body, at: Option<&[Vec3]>) -> Result<Self, Error> {
+        let matrix = stiffness(body, at);
         let n = body.particle_count();
         let mut dof = vec![u32::MAX; n];
         let mut free = 0;
@@ -296,7 +312,7 @@ pub fn linear_response(
             prescribed.len()
         )));
     }
-    let k = FactorisedStiffness::new(body)?;
+    let k = FactorisedStiffness::new(body, None)?;
     // Move the prescribed displacements to the right-hand side: f − K u_b.
     let boundary: Vec<Vec3> = (0..n)
         .map(|i| {
@@ -330,19 +346,19 @@ pub fn linear_gravity_sag(body: &Body, g: Vec3) -> Result<Vec<Vec3>, Error> {
 /// Outcome of a nonlinear static solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SettleReport {
-    /// Modified-Newton iterations used.
+    /// Newton iterations used.
     pub iterations: u32,
-    /// Largest force residual on a free particle at the end, relative to the largest particle
-    /// weight (dimensionless).
+    /// Force residual at the end (L2 over the free particles) relative to the weight (L2 of
+    /// the particle weights) (dimensionless).
     pub relative_residual: Real,
     /// True when the residual reached the tolerance.
     pub converged: bool,
 }
 
 /// Relative force residual at which [`settle_body`] stops.
-pub const SETTLE_TOLERANCE: Real = 1.0e-9;
+pub const SETTLE_TOLERANCE: Real = 1.0e-7;
 /// Largest number of modified-Newton iterations of [`settle_body`].
-pub const SETTLE_MAX_ITERATIONS: u32 = 200;
+pub const SETTLE_MAX_ITERATIONS: u32 = 100;
 
 /// The force residual (N) of `body` at positions `x` (m) under gravity `g`: elastic, hourglass
 /// and volume forces plus the weight; zero on fixed particles.
@@ -359,53 +375,97 @@ fn residual(body: &Body, x: &[Vec3], g: Vec3) -> Vec<Vec3> {
     r
 }
 
-fn max_norm(v: &[Vec3]) -> Real {
-    v.iter().map(|x| x.norm()).fold(0.0, Real::max)
+/// L2 norm of `v`.
+fn l2(v: &[Vec3]) -> Real {
+    v.iter().map(|x| x.norm_squared()).sum::<Real>().sqrt()
 }
 
-/// Move `body`'s free particles to their static equilibrium under gravity `g` (m/s²), from
-/// their current positions; velocities are set to zero. Returns the iterations and residual.
-pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Error> {
-    let k = FactorisedStiffness::new(body)?;
+/// Newton-like iterations toward the equilibrium under gravity `g` from `x`, at most
+/// `max_iterations`; returns the relative residual reached (`|r| / |m g|`, L2).
+fn newton(
+    body: &Body,
+    x: &mut Vec<Vec3>,
+    g: Vec3,
+    tolerance: Real,
+    max_iterations: u32,
+    iterations: &mut u32,
+) -> Result<Real, Error> {
     let weight = body
         .mass
         .iter()
-        .map(|m| (g * *m).norm())
-        .fold(0.0, Real::max)
+        .map(|m| (g * *m).norm_squared())
+        .sum::<Real>()
+        .sqrt()
         .max(Real::MIN_POSITIVE);
-    let mut x = body.x.clone();
-    let mut r = residual(body, &x, g);
-    let mut res = max_norm(&r) / weight;
+    let mut r = residual(body, x, g);
+    let mut res = l2(&r) / weight;
     let mut dx = vec![Vec3::zeros(); x.len()];
-    let mut iterations = 0;
-    while res > SETTLE_TOLERANCE && iterations < SETTLE_MAX_ITERATIONS {
-        iterations += 1;
+    for _ in 0..max_iterations {
+        if res <= tolerance {
+            break;
+        }
+        *iterations += 1;
+        // The corotated (warped) stiffness at the current positions: a good model of the
+        // tangent under large rotations.
+        let k = FactorisedStiffness::new(body, Some(x))?;
         k.solve(&r, &mut dx);
-        // Backtrack while the residual grows (large rotations make the rest stiffness a poor
-        // model); accept the smallest step tried otherwise.
+        // Backtrack while the residual grows.
         let mut step = 1.0;
-        let (mut x_try, mut r_try, mut res_try);
         loop {
-            x_try = x
-                .iter()
-                .zip(&dx)
-                .map(|(x, d)| x + d * step)
-                .collect::<Vec<_>>();
-            r_try = residual(body, &x_try, g);
-            res_try = max_norm(&r_try) / weight;
-            if res_try < res || step < 1.0 / 64.0 || !res_try.is_finite() {
+            let x_try: Vec<Vec3> = x.iter().zip(&dx).map(|(x, d)| x + d * step).collect();
+            let r_try = residual(body, &x_try, g);
+            let res_try = l2(&r_try) / weight;
+            if res_try.is_finite() && res_try < res {
+                *x = x_try;
+                r = r_try;
+                res = res_try;
                 break;
             }
             step *= 0.5;
+            if step < 1.0 / 32.0 {
+                return Ok(res);
+            }
         }
-        if !res_try.is_finite() {
-            return Err(Error::Diverged(
-                "settle: the static solve produced non-finite positions".into(),
-            ));
+    }
+    Ok(res)
+}
+
+/// Move `body`'s free particles to their static equilibrium under gravity `g` (m/s²), from
+/// their current positions; velocities are set to zero. Gravity is applied in increments
+/// (halved when an increment does not converge) so that large sags converge. Returns the
+/// iterations and residual.
+pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Error> {
+    let mut x = body.x.clone();
+    let mut iterations = 0;
+    let mut load = 0.0;
+    let mut increment: Real = 0.25;
+    let mut res = Real::INFINITY;
+    while load < 1.0 && iterations < SETTLE_MAX_ITERATIONS {
+        let next = (load + increment).min(1.0);
+        let mut trial = x.clone();
+        let reached = newton(
+            body,
+            &mut trial,
+            g * next,
+            SETTLE_TOLERANCE,
+            12,
+            &mut iterations,
+        )?;
+        if reached <= SETTLE_TOLERANCE {
+            x = trial;
+            load = next;
+            res = reached;
+            increment *= 1.5;
+        } else if increment < 1.0 / 256.0 {
+            x = trial;
+            res = reached;
+            break;
+        } else {
+            increment *= 0.5;
         }
-        x = x_try;
-        r = r_try;
-        res = res_try;
+    }
+    if load < 1.0 {
+        res = res.max(SETTLE_TOLERANCE * 2.0);
     }
     body.x.copy_from_slice(&x);
     body.p.copy_from_slice(&x);
@@ -417,6 +477,6 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Erro
     Ok(SettleReport {
         iterations,
         relative_residual: res,
-        converged: res <= SETTLE_TOLERANCE,
+        converged: load >= 1.0 && res <= SETTLE_TOLERANCE,
     })
 }
