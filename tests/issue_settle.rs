@@ -26,10 +26,9 @@ fn a_settled_body_matches_the_linear_sag_and_stays_at_rest() {
     eprintln!("{report:?}");
     let b = world.body(id).unwrap();
     let (mut e, mut n) = (0.0, 0.0);
-    for i in 0..linear.len() {
-        let u = b.positions()[i] - b.rest_positions()[i];
-        e += (u - linear[i]).norm_squared();
-        n += linear[i].norm_squared();
+    for ((x, x0), lin) in b.positions().iter().zip(b.rest_positions()).zip(&linear) {
+        e += (x - x0 - lin).norm_squared();
+        n += lin.norm_squared();
     }
     eprintln!("settled vs linear: {:e}", (e / n).sqrt());
     assert!(report[0].converged, "{report:?}");
