@@ -3,9 +3,13 @@
 //! ν 0.3, ρ 1, g 0.981, top 10% fixed), compared with scikit-fem by `validation/organ_check.sh`.
 //!
 //! ```text
-//! cargo run --release --example organ_check -- export DIR          # DIR/organ.node, .ele
+//! cargo run --release --example organ_check -- export DIR [CELL]   # DIR/organ.node, .ele
 //! cargo run --release --example organ_check -- run CSV [HOURGLASS]  # node,ux,uy,uz at equilibrium
 //! ```
+//!
+//! `export` writes the organ of `tissuesim::mesh::organ_with_cell(CELL)` (lattice cell edge in m,
+//! default 0.0095 = the default organ), scaled ×30 like `run`; `validation/fem_reference.py
+//! --scene organ` solves it at CELL = 0.0133, 0.0095 and 0.0068.
 
 use std::io::Write;
 use std::path::Path;
@@ -15,13 +19,20 @@ type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let mut organ = tissuesim::mesh::default_organ();
-    for p in &mut organ.nodes {
-        *p *= 30.0;
-    }
+    let scaled = |mut organ: tissuesim::mesh::TetMesh| {
+        for p in &mut organ.nodes {
+            *p *= 30.0;
+        }
+        organ
+    };
     match args.first().map(String::as_str) {
         Some("export") => {
-            let dir = Path::new(args.get(1).ok_or("export DIR")?);
+            let dir = Path::new(args.get(1).ok_or("export DIR [CELL]")?);
+            let cell: f64 = match args.get(2) {
+                Some(c) => c.parse()?,
+                None => 0.0095,
+            };
+            let organ = scaled(tissuesim::mesh::organ_with_cell(cell));
             std::fs::create_dir_all(dir)?;
             let mut f = std::fs::File::create(dir.join("organ.node"))?;
             writeln!(f, "{} 3 0 0", organ.nodes.len())?;
@@ -41,9 +52,13 @@ fn main() -> Res<()> {
                 Some(h) => h.parse()?,
                 None => Settings::default().hourglass_stiffness,
             };
-            run(&organ, Path::new(out), hourglass)
+            run(
+                &scaled(tissuesim::mesh::default_organ()),
+                Path::new(out),
+                hourglass,
+            )
         }
-        _ => Err("usage: organ_check export DIR | run CSV [HOURGLASS]".into()),
+        _ => Err("usage: organ_check export DIR [CELL] | run CSV [HOURGLASS]".into()),
     }
 }
 
