@@ -71,6 +71,7 @@ pub mod vr {
     pub const GRAVITY_X: u32 = 38;
     pub const GRAVITY_Y: u32 = 39;
     pub const GRAVITY_Z: u32 = 40;
+    pub const THREADS: u32 = 41;
 }
 
 /// Default tool position (m): ~1.7 cm in front (+z) of the default organ's right lobe at
@@ -256,6 +257,18 @@ pub static VARIABLES: &[Variable] = &[
     param(vr::GRAVITY_X, "gravity_x", Tunable, "m/s2", 0.0, None, "Gravity acceleration x"),
     param(vr::GRAVITY_Y, "gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
     param(vr::GRAVITY_Z, "gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
+    Variable {
+        name: "threads",
+        vr: vr::THREADS,
+        causality: Parameter,
+        variability: Fixed,
+        kind: Kind::Integer {
+            start: Some(1),
+            min: Some(1),
+            max: Some(64),
+        },
+        description: "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count",
+    },
 ];
 
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -578,6 +591,7 @@ fn settings_from(store: &Store, base: &Settings, dt: f64) -> Settings {
     s.damping_mass = store.real(vr::DAMPING);
     s.volume_compliance = store.real(vr::VOLUME_COMPLIANCE);
     s.volume_constraints = store.boolean(vr::VOLUME_CONSTRAINTS);
+    s.threads = store.integer(vr::THREADS).clamp(1, 64) as u32;
     s
 }
 
@@ -764,7 +778,7 @@ mod tests {
     #[test]
     fn table_is_consistent() {
         check_table(VARIABLES, UNITS).unwrap();
-        assert_eq!(VARIABLES.len(), vr::GRAVITY_Z as usize + 1);
+        assert_eq!(VARIABLES.len(), vr::THREADS as usize + 1);
     }
 
     /// docs/FMU.md documents every variable, in table order.

@@ -156,6 +156,19 @@ def test_force_vanishes_out_of_contact(press_result):
         assert np.all(np.abs(r[name][free]) < 1e-9), name
 
 
+def test_threads_parameter_gives_bit_identical_outputs(fmu_path, press_result):
+    """threads = 2 runs the force pass on two threads; every output is bit for bit the one of
+    the default single-threaded run."""
+    times = [0.0, 0.3, 0.8, 0.9, 1.2, 1.6]
+    ys = [press_z(t) for t in times]
+    signals = np.array(list(zip(times, ys)), dtype=[("time", np.double), ("tool_pz", np.double)])
+    r = simulate_fmu(fmu_path, start_time=0.0, stop_time=1.6, step_size=H, input=signals,
+                     start_values={"threads": 2}, output=OUTPUTS_REAL + ["contact_count", "tool_pz"])
+    assert np.any(r["contact_count"] > 0)
+    for name in OUTPUTS_REAL + ["contact_count"]:
+        assert np.array_equal(r[name], press_result[name]), name
+
+
 def test_volume_is_conserved_within_one_percent(fmu_path):
     """The volume constraints carry the material's bulk stiffness: nearly incompressible tissue
     (nu = 0.49) keeps its volume within 1% while hanging and being pressed. (At the default
