@@ -343,22 +343,37 @@ pub fn linear_gravity_sag(body: &Body, g: Vec3) -> Result<Vec<Vec3>, Error> {
     linear_response(body, &load, &vec![Vec3::zeros(); body.particle_count()])
 }
 
-/// Outcome of a nonlinear static solve.
+/// Outcome of [`World::settle`](crate::World::settle).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SettleReport {
-    /// Newton iterations used.
-    pub iterations: u32,
-    /// Force residual at the end (L2 over the free particles) relative to the weight (L2 of
-    /// the particle weights) (dimensionless).
+    /// Newton iterations of the static solve, over all bodies.
+    pub newton_iterations: u32,
+    /// Largest force residual the static solve left on a body, L2 over its free particles
+    /// relative to the L2 of its particle weights (dimensionless).
     pub relative_residual: Real,
-    /// True when the residual reached the tolerance.
+    /// Steps of the dynamic relaxation that followed (each `Settings::dt` long; simulated time
+    /// is not advanced by `settle`).
+    pub relaxation_steps: u32,
+    /// Largest particle speed at the end (m/s).
+    pub max_speed: Real,
+    /// True when the largest particle speed fell below [`SETTLE_SPEED`].
     pub converged: bool,
 }
 
-/// Relative force residual at which [`settle_body`] stops.
+/// Relative force residual at which the static solve stops.
 pub const SETTLE_TOLERANCE: Real = 1.0e-7;
-/// Largest number of modified-Newton iterations of [`settle_body`].
-pub const SETTLE_MAX_ITERATIONS: u32 = 100;
+/// Largest number of Newton iterations of the static solve, per body.
+pub const SETTLE_MAX_ITERATIONS: u32 = 4;
+/// Particle speed (m/s) below which a settled world counts as at rest.
+pub const SETTLE_SPEED: Real = 1.0e-5;
+/// Largest number of dynamic-relaxation steps of `settle`.
+pub const SETTLE_MAX_STEPS: u32 = 20_000;
+
+/// What the static solve of one body reached.
+pub(crate) struct StaticSolve {
+    pub(crate) iterations: u32,
+    pub(crate) relative_residual: Real,
+}
 
 /// The force residual (N) of `body` at positions `x` (m) under gravity `g`: elastic, hourglass
 /// and volume forces plus the weight; zero on fixed particles.
@@ -430,42 +445,25 @@ fn newton(
     Ok(res)
 }
 
-/// Move `body`'s free particles to their static equilibrium under gravity `g` (m/s²), from
-/// their current positions; velocities are set to zero. Gravity is applied in increments
-/// (halved when an increment does not converge) so that large sags converge. Returns the
-/// iterations and residual.
-pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Error> {
+/// Move `body`'s free particles toward their static equilibrium under gravity `g` (m/s²),
+/// from their current positions, in at most [`SETTLE_MAX_ITERATIONS`] Newton iterations; the
+/// result is kept only if it converged (otherwise the positions are left as they were).
+/// Velocities are set to zero. Returns the iterations and the residual reached.
+pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error> {
     let mut x = body.x.clone();
     let mut iterations = 0;
-    let mut load = 0.0;
-    let mut increment: Real = 0.25;
-    let mut res = Real::INFINITY;
-    while load < 1.0 && iterations < SETTLE_MAX_ITERATIONS {
-        let next = (load + increment).min(1.0);
-        let mut trial = x.clone();
-        let reached = newton(
-            body,
-            &mut trial,
-            g * next,
-            SETTLE_TOLERANCE,
-            12,
-            &mut iterations,
-        )?;
-        if reached <= SETTLE_TOLERANCE {
-            x = trial;
-            load = next;
-            res = reached;
-            increment *= 1.5;
-        } else if increment < 1.0 / 256.0 {
-            x = trial;
-            res = reached;
-            break;
-        } else {
-            increment *= 0.5;
-        }
-    }
-    if load < 1.0 {
-        res = res.max(SETTLE_TOLERANCE * 2.0);
+    let res = newton(
+        body,
+        &mut x,
+        g,
+        SETTLE_TOLERANCE,
+        SETTLE_MAX_ITERATIONS,
+        &mut iterations,
+    )?;
+    if res > SETTLE_TOLERANCE {
+        // Not converged (a large sag): an unconverged iterate can hold strongly distorted
+        // particles, so keep the starting positions and leave the work to the relaxation.
+        x.copy_from_slice(&body.x);
     }
     body.x.copy_from_slice(&x);
     body.p.copy_from_slice(&x);
@@ -474,9 +472,8 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<SettleReport, Erro
         let f = crate::elastic::deformation_gradient(&body.nbr, &x, i);
         body.rotation[i] = crate::elastic::rotation_from_svd(&f);
     }
-    Ok(SettleReport {
+    Ok(StaticSolve {
         iterations,
         relative_residual: res,
-        converged: load >= 1.0 && res <= SETTLE_TOLERANCE,
     })
 }

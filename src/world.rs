@@ -318,22 +318,83 @@ impl World {
         }
     }
 
-    /// Move every body to its static equilibrium under gravity with its fixed particles held,
-    /// and set every velocity to zero: a scene that starts from `settle()` is at rest instead
-    /// of swinging into place. Tools and organ–organ contacts are not considered (settle
-    /// before the tools touch the tissue). One report per body, in body order.
+    /// Bring the world to rest in its equilibrium under gravity, fixed particles held: a scene
+    /// that starts from `settle()` hangs still instead of swinging into place. Two stages:
+    /// a static solve of each body's discrete energy (Newton iterations with the corotated
+    /// stiffness, sparse direct factorisation, at most [`SETTLE_MAX_ITERATIONS`] per body; exact
+    /// for moderate sags), then dynamic relaxation with the world's own step and kinetic
+    /// damping (every velocity zeroed whenever the kinetic energy passes a peak) until no
+    /// particle moves faster than [`SETTLE_SPEED`] or [`SETTLE_MAX_STEPS`] steps. The second
+    /// stage ends in the equilibrium the step itself holds, tools included. Simulated time is
+    /// not advanced and velocities end at zero.
     ///
     /// Fails without changing anything for a body with no fixed particle (a free body has no
-    /// static equilibrium under gravity).
-    pub fn settle(&mut self) -> Result<Vec<crate::statics::SettleReport>, Error> {
+    /// static equilibrium under gravity), or if a relaxation step diverges.
+    ///
+    /// [`SETTLE_MAX_ITERATIONS`]: crate::statics::SETTLE_MAX_ITERATIONS
+    /// [`SETTLE_SPEED`]: crate::statics::SETTLE_SPEED
+    /// [`SETTLE_MAX_STEPS`]: crate::statics::SETTLE_MAX_STEPS
+    pub fn settle(&mut self) -> Result<crate::statics::SettleReport, Error> {
+        use crate::statics::{settle_body, SettleReport, SETTLE_MAX_STEPS, SETTLE_SPEED};
         let g = self.settings.gravity;
         let mut settled = self.bodies.clone();
-        let mut reports = Vec::with_capacity(settled.len());
+        let (mut newton_iterations, mut relative_residual) = (0, 0.0 as Real);
         for body in &mut settled {
-            reports.push(crate::statics::settle_body(body, g)?);
+            let s = settle_body(body, g)?;
+            newton_iterations += s.iterations;
+            relative_residual = relative_residual.max(s.relative_residual);
         }
-        self.bodies = settled;
-        Ok(reports)
+        let before = std::mem::replace(&mut self.bodies, settled);
+        let time = self.time;
+        let kinetic = |w: &World| -> Real {
+            w.bodies
+                .iter()
+                .flat_map(|b| b.v.iter().zip(&b.inertial_mass))
+                .map(|(v, m)| m * v.norm_squared())
+                .sum()
+        };
+        let max_speed = |w: &World| -> Real {
+            w.bodies
+                .iter()
+                .flat_map(|b| b.v.iter())
+                .map(|v| v.norm())
+                .fold(0.0, Real::max)
+        };
+        let mut previous = 0.0;
+        let mut steps = 0;
+        let mut speed = Real::INFINITY;
+        while steps < SETTLE_MAX_STEPS {
+            if let Err(e) = self.step() {
+                self.bodies = before;
+                self.time = time;
+                return Err(e);
+            }
+            steps += 1;
+            speed = max_speed(self);
+            if speed < SETTLE_SPEED {
+                break;
+            }
+            let k = kinetic(self);
+            if k < previous {
+                for b in &mut self.bodies {
+                    b.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+                }
+                previous = 0.0;
+            } else {
+                previous = k;
+            }
+        }
+        for b in &mut self.bodies {
+            b.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+        }
+        self.time = time;
+        Ok(SettleReport {
+            newton_iterations,
+            relative_residual,
+            relaxation_steps: steps,
+            max_speed: speed,
+            converged: speed < SETTLE_SPEED,
+        })
     }
 
     /// Advance the world by `settings.dt`. On NaN/Inf the world is rolled back and

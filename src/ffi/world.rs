@@ -339,13 +339,13 @@ pub unsafe extern "C" fn ts_world_step(
     })
 }
 
-/// Move every body to its static equilibrium under gravity, fixed particles held, velocities
-/// zero: start a scene at rest instead of letting it swing into place (Newton iterations with
-/// the corotated stiffness and a sparse direct factorisation, gravity in increments; tools
-/// and organ contacts are ignored, so settle before a tool touches the tissue). Reliable for
-/// moderate sags; a sag of several centimetres on a 0.2 m organ may not converge yet (the
-/// positions reached are kept). Fails with TS_STATUS_INVALID_ARGUMENT and changes nothing
-/// when a body has no fixed particle. Allocates: not for the haptic loop.
+/// Bring the world to rest in its equilibrium under gravity, fixed particles held: a scene
+/// started from ts_world_settle hangs still instead of swinging into place. A static solve
+/// (Newton, corotated stiffness, sparse direct factorisation; kept if it converges), then
+/// dynamic relaxation with the world's own step until no particle moves faster than 10 um/s.
+/// Simulated time is not advanced; velocities end at zero. Fails with
+/// TS_STATUS_INVALID_ARGUMENT and changes nothing when a body has no fixed particle.
+/// Allocates and may take seconds: not for the haptic loop.
 ///
 /// # Safety
 ///
