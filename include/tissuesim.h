@@ -168,7 +168,7 @@ typedef struct ts_settings {
      */
     double damping_stiffness;
     /**
-     * Hourglass-control stiffness (dimensionless, times Young's modulus), >= 0.
+     * Hourglass-control stiffness (dimensionless, times the shear modulus mu), >= 0.
      */
     double hourglass_stiffness;
     /**
@@ -217,6 +217,27 @@ typedef struct ts_settings {
      * count.
      */
     uint32_t threads;
+    /**
+     * Divergence check: largest particle speed, in body sizes per second (1/s, > 0; default
+     * 250, i.e. 50 m/s for a 0.2 m organ). A step beyond it is rolled back and returns
+     * TS_STATUS_DIVERGED. +infinity switches the check off.
+     */
+    double divergence_max_speed;
+    /**
+     * Divergence check: largest extent of a body (deformed bounding-box diagonal) over its
+     * rest size (dimensionless, > 1; default 10). +infinity switches it off.
+     */
+    double divergence_max_extent_ratio;
+    /**
+     * Divergence check: smallest accepted body volume over rest volume (dimensionless, in
+     * [0, 1); default 0.1).
+     */
+    double divergence_min_volume_ratio;
+    /**
+     * Divergence check: largest accepted body volume over rest volume (dimensionless, > 1;
+     * default 10). +infinity switches it off.
+     */
+    double divergence_max_volume_ratio;
 } ts_settings;
 
 /**
@@ -243,7 +264,8 @@ typedef struct ts_material {
      */
     double youngs_modulus;
     /**
-     * Poisson ratio nu (dimensionless), in (-1, 0.5).
+     * Poisson ratio nu (dimensionless), in [0, 0.49]: negative values are auxetic (not
+     * tissue) and unstable here; the volumetric stiffness diverges as nu approaches 0.5.
      */
     double poisson_ratio;
     /**
@@ -258,14 +280,16 @@ typedef struct ts_material {
 typedef struct ts_body_options {
     /**
      * Support radius of every particle (m); 0 chooses one per particle automatically.
+     * Otherwise in [0.5, 3] x the mesh's mean edge length (and at most 384 neighbours).
      */
     double support_radius;
     /**
-     * Contact radius of the particles (m); 0 derives it from the particle spacing.
+     * Contact radius of the particles (m); 0 derives it from the particle spacing (half the
+     * mean edge length). Otherwise in [0.05, 2] x the mesh's mean edge length.
      */
     double particle_radius;
     /**
-     * Target number of neighbours when the support radius is automatic (>= 1).
+     * Target number of neighbours when the support radius is automatic (1..=96).
      */
     uint32_t target_neighbours;
 } ts_body_options;

@@ -15,13 +15,51 @@ use crate::settings::Settings;
 pub struct Material {
     /// Young's modulus E (Pa).
     pub youngs_modulus: Real,
-    /// Poisson ratio ν (dimensionless, in (-1, 0.5)).
+    /// Poisson ratio ν (dimensionless, in [0, 0.49]: see [`MAX_POISSON_RATIO`]).
     pub poisson_ratio: Real,
     /// Mass density ρ (kg/m³).
     pub density: Real,
 }
 
+/// The range of Poisson ratios a body accepts: `[MIN_POISSON_RATIO, MAX_POISSON_RATIO]`.
+///
+/// Below 0 a material is auxetic (it widens when stretched): no soft tissue is, and the
+/// corotated stress with volume constraints was seen to explode there (ν = −0.5 and
+/// ν → −1 turned organs inside out under a probe). Towards 0.5 the volumetric stiffness
+/// λ = Eν/((1+ν)(1−2ν)) diverges (λ/μ = 2ν/(1−2ν) is 98 at 0.49, ∞ at 0.5); 0.49 keeps the
+/// volume within 0.5% under a 9 cm sag (nearly incompressible tissue), and beyond it the
+/// volume constraints become so stiff that contact and friction stall.
+pub const MIN_POISSON_RATIO: Real = 0.0;
+/// See [`MIN_POISSON_RATIO`].
+pub const MAX_POISSON_RATIO: Real = 0.49;
+
 impl Material {
+    /// Check the material: E > 0 Pa, ν in [[`MIN_POISSON_RATIO`], [`MAX_POISSON_RATIO`]],
+    /// ρ > 0 kg/m³, all finite. The message names the field, the range and why.
+    pub fn validate(&self) -> Result<(), Error> {
+        let bad = |s: String| Err(Error::InvalidArgument(s));
+        if !(self.youngs_modulus.is_finite() && self.youngs_modulus > 0.0) {
+            return bad(format!(
+                "Young's modulus must be finite and > 0 Pa, got {}",
+                self.youngs_modulus
+            ));
+        }
+        let nu = self.poisson_ratio;
+        if !(nu.is_finite() && (MIN_POISSON_RATIO..=MAX_POISSON_RATIO).contains(&nu)) {
+            return bad(format!(
+                "Poisson ratio must be in [{MIN_POISSON_RATIO}, {MAX_POISSON_RATIO}], got {nu}: \
+                 negative values are auxetic (not tissue) and unstable here, and the volumetric \
+                 stiffness lambda = E nu / ((1 + nu)(1 - 2 nu)) diverges as nu -> 0.5"
+            ));
+        }
+        if !(self.density.is_finite() && self.density > 0.0) {
+            return bad(format!(
+                "density must be finite and > 0 kg/m3, got {}",
+                self.density
+            ));
+        }
+        Ok(())
+    }
     /// First Lamé parameter λ = Eν / ((1 + ν)(1 - 2ν)) (Pa): under the volumetric split the
     /// volume constraints get compliance `1/λ`.
     pub fn lame_lambda(&self) -> Real {
@@ -45,6 +83,22 @@ impl Default for Material {
     }
 }
 
+/// Largest distance (in body sizes: the diagonal of the rest bounding box) of a particle from
+/// the centre of its body's rest bounding box that [`World::set_body_state`] and
+/// [`World::restore_state`] accept. Beyond it a state is not a deformed organ but garbage (a
+/// crafted buffer, a unit error), and stepping it would only overflow.
+///
+/// [`World::set_body_state`]: crate::World::set_body_state
+/// [`World::restore_state`]: crate::World::restore_state
+pub const STATE_POSITION_LIMIT: Real = 100.0;
+
+/// Largest particle speed (in body sizes per second) that [`World::set_body_state`] and
+/// [`World::restore_state`] accept (200 m/s for a 0.2 m organ).
+///
+/// [`World::set_body_state`]: crate::World::set_body_state
+/// [`World::restore_state`]: crate::World::restore_state
+pub const STATE_SPEED_LIMIT: Real = 1000.0;
+
 /// Options for building a body.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BodyOptions {
@@ -63,6 +117,51 @@ pub struct BodyOptions {
     /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
     /// gradients of the paper (for comparison only).
     pub consistent_gradients: bool,
+}
+
+/// Accepted range of [`BodyOptions::particle_radius`], in mean tetrahedron edge lengths: a
+/// radius far below the spacing lets particles pass between each other and makes every swept
+/// tool motion need countless substeps; far above it, neighbouring particles of one body
+/// overlap and tool contact pushes whole regions at once.
+pub const PARTICLE_RADIUS_RANGE: (Real, Real) = (0.05, 2.0);
+
+/// Accepted range of [`BodyOptions::support_radius`], in mean tetrahedron edge lengths: below,
+/// a particle has too few neighbours for a well-conditioned moment matrix; above, the neighbour
+/// count (and the memory and time of every step) grows with the cube of the radius.
+pub const SUPPORT_RADIUS_RANGE: (Real, Real) = (0.5, 3.0);
+
+impl BodyOptions {
+    /// Check the material and the radii against a mesh of mean edge length `mean_edge` (m):
+    /// explicit radii must lie in [`PARTICLE_RADIUS_RANGE`] and [`SUPPORT_RADIUS_RANGE`] (in
+    /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](neighbours::MAX_NEIGHBOURS).
+    pub fn check_radii(&self, mean_edge: Real) -> Result<(), Error> {
+        self.material.validate()?;
+        for (name, value, (lo, hi)) in [
+            (
+                "particle_radius",
+                self.particle_radius,
+                PARTICLE_RADIUS_RANGE,
+            ),
+            ("support_radius", self.support_radius, SUPPORT_RADIUS_RANGE),
+        ] {
+            let Some(r) = value else { continue };
+            let (min, max) = (lo * mean_edge, hi * mean_edge);
+            if !(r.is_finite() && r >= min && r <= max) {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} {r:e} m is outside [{min:.3e}, {max:.3e}] m, i.e. [{lo}, {hi}] x the \
+                     mesh's mean edge length {mean_edge:.3e} m"
+                )));
+            }
+        }
+        let k = self.target_neighbours as usize;
+        if !(1..=neighbours::MAX_NEIGHBOURS).contains(&k) {
+            return Err(Error::InvalidArgument(format!(
+                "target_neighbours must be in 1..={}, got {k}",
+                neighbours::MAX_NEIGHBOURS
+            )));
+        }
+        Ok(())
+    }
 }
 
 impl Default for BodyOptions {
@@ -119,6 +218,10 @@ pub struct Body {
     pub(crate) tet_lambda: Vec<Real>,
     pub(crate) boundary: Vec<[u32; 3]>,
     pub(crate) particle_radius: Real,
+    /// Centre of the rest bounding box (m).
+    pub(crate) rest_centre: Vec3,
+    /// Diagonal of the rest bounding box (m): the body's size.
+    pub(crate) size: Real,
     pub(crate) rest_volume: Real,
     /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
     /// split) disables them.
@@ -146,29 +249,7 @@ impl Body {
     ) -> Result<Body, Error> {
         let m = &options.material;
         let bad = |s: String| Err(Error::InvalidArgument(s));
-        if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
-            return bad(format!(
-                "Young's modulus must be > 0 Pa, got {}",
-                m.youngs_modulus
-            ));
-        }
-        if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-            return bad(format!(
-                "Poisson ratio must be in (-1, 0.5), got {}",
-                m.poisson_ratio
-            ));
-        }
-        if !(m.density.is_finite() && m.density > 0.0) {
-            return bad(format!("density must be > 0 kg/m3, got {}", m.density));
-        }
-        for r in [options.support_radius, options.particle_radius]
-            .into_iter()
-            .flatten()
-        {
-            if !(r.is_finite() && r > 0.0) {
-                return bad(format!("radii must be finite and > 0 m, got {r}"));
-            }
-        }
+        m.validate()?;
         let n = mesh.nodes.len();
         if mesh.tets.is_empty() || n < 5 {
             return bad("a body needs at least one tetrahedron and 5 nodes".into());
@@ -195,6 +276,7 @@ impl Body {
         if let Some(k) = particle_volume.iter().position(|&v| v <= 0.0) {
             return bad(format!("node {k} belongs to no tetrahedron"));
         }
+        options.check_radii(mesh.mean_edge_length())?;
         let support = match options.support_radius {
             Some(h) => SupportRadius::Fixed(h),
             None => SupportRadius::Automatic {
@@ -210,6 +292,7 @@ impl Body {
         let particle_radius = options
             .particle_radius
             .unwrap_or_else(|| 0.5 * mesh.mean_edge_length());
+        let (lo, hi) = mesh.bounding_box();
         let mut body = Body {
             material: *m,
             model: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
@@ -233,6 +316,8 @@ impl Body {
             tets: mesh.tets.clone(),
             boundary,
             particle_radius,
+            rest_centre: (lo + hi) * 0.5,
+            size: (hi - lo).norm(),
             omega_max: 0.0,
             volume_compliance: 0.0,
             volume_constraints_on: false,
@@ -242,6 +327,35 @@ impl Body {
         };
         body.configure(settings);
         Ok(body)
+    }
+
+    /// Check a particle state against [`STATE_POSITION_LIMIT`] and [`STATE_SPEED_LIMIT`]
+    /// (and finiteness): the first offending particle, as a message, on failure.
+    pub(crate) fn check_state(&self, i: usize, x: &Vec3, v: &Vec3) -> Result<(), String> {
+        if !is_finite_vec(x) {
+            return Err(format!("particle {i}: non-finite position"));
+        }
+        if !is_finite_vec(v) {
+            return Err(format!("particle {i}: non-finite velocity"));
+        }
+        let (d, far) = (
+            (x - self.rest_centre).norm(),
+            STATE_POSITION_LIMIT * self.size,
+        );
+        if d > far {
+            return Err(format!(
+                "particle {i}: position {d:.3e} m from the body's rest centre, beyond the limit \
+                 of {far:.3e} m ({STATE_POSITION_LIMIT} body sizes)"
+            ));
+        }
+        let (speed, fast) = (v.norm(), STATE_SPEED_LIMIT * self.size);
+        if speed > fast {
+            return Err(format!(
+                "particle {i}: velocity {speed:.3e} m/s above the limit of {fast:.3e} m/s \
+                 ({STATE_SPEED_LIMIT} body sizes per second)"
+            ));
+        }
+        Ok(())
     }
 
     /// Number of particles (= mesh nodes).

@@ -151,7 +151,19 @@ pub fn rotation_from_svd(f: &Mat3) -> Quat {
         }
         u.column_mut(k).neg_mut();
     }
-    Quat::from_matrix(&(u * v_t))
+    let r = u * v_t;
+    if !r.iter().all(|c| c.is_finite()) {
+        return Quat::identity();
+    }
+    // `from_matrix` iterates without bound (a matrix that overflowed inside the SVD never
+    // converges: a hang); 100 iterations are plenty for the orthogonal `U Vᵀ`.
+    let rot = nalgebra::Rotation3::from_matrix_eps(
+        &r,
+        Real::EPSILON,
+        100,
+        nalgebra::Rotation3::identity(),
+    );
+    Quat::from_rotation_matrix(&rot)
 }
 
 /// First Piola–Kirchhoff stress (Pa) of the corotated model for deformation gradient `f` and

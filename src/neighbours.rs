@@ -16,6 +16,10 @@ pub const MAX_MOMENT_CONDITION: Real = 200.0;
 /// Largest number of neighbours the automatic support radius may reach for one particle.
 pub const MAX_NEIGHBOURS: usize = 96;
 
+/// Largest number of neighbours a fixed support radius may give one particle (the step's time
+/// and memory grow with it).
+pub const MAX_FIXED_NEIGHBOURS: usize = 4 * MAX_NEIGHBOURS;
+
 /// Neighbour lists of every particle of a body (CSR) and their rest-state quantities.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Neighbourhoods {
@@ -102,6 +106,12 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
             SupportRadius::Fixed(h) => {
                 grid.within(rest, i, h, &mut candidates);
                 let c = candidates.len();
+                if c > MAX_FIXED_NEIGHBOURS {
+                    return Err(format!(
+                        "particle {i}: support_radius {h} m holds {c} neighbours, more than \
+                         {MAX_FIXED_NEIGHBOURS}; use a smaller radius"
+                    ));
+                }
                 if moment_condition(rest, i, &candidates[..c], h) > MAX_MOMENT_CONDITION {
                     return Err(format!(
                         "particle {i}: support radius {h} m gives an ill-conditioned moment \

@@ -139,8 +139,11 @@ impl World {
     }
 
     /// Restore a state written by [`World::save_state`] of a world built the same way. On any
-    /// mismatch (magic, version, counts, size, checksum, non-finite values) the world is left
-    /// unchanged and [`Error::BadState`] says why.
+    /// mismatch (magic, version, counts, size, checksum, non-finite values, a particle
+    /// farther than [`STATE_POSITION_LIMIT`](crate::body::STATE_POSITION_LIMIT) body sizes from
+    /// its body's rest centre or faster than
+    /// [`STATE_SPEED_LIMIT`](crate::body::STATE_SPEED_LIMIT) body sizes per second) the world
+    /// is left unchanged and [`Error::BadState`] says why.
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), Error> {
         let bad = |m: &str| Err(Error::BadState(m.to_string()));
         if bytes.len() < HEADER + 8 || &bytes[..8] != MAGIC {
@@ -183,10 +186,24 @@ impl World {
         if !scan.f64().is_finite() {
             return bad("non-finite time");
         }
-        for b in &self.bodies {
+        for (k, b) in self.bodies.iter().enumerate() {
             scan.at += 4;
-            if (0..b.particle_count() * 10).any(|_| !scan.f64().is_finite()) {
-                return bad("non-finite particle state");
+            let n = b.particle_count();
+            let velocities = scan.at + n * 24;
+            for i in 0..n {
+                let x = scan.vec3();
+                let mut at_v = Reader {
+                    bytes,
+                    at: velocities + i * 24,
+                };
+                let v = at_v.vec3();
+                if let Err(m) = b.check_state(i, &x, &v) {
+                    return Err(Error::BadState(format!("body {k} {m}")));
+                }
+            }
+            scan.at = velocities + n * 24;
+            if (0..n * 4).any(|_| !scan.f64().is_finite()) {
+                return bad("non-finite particle rotation");
             }
         }
         for _ in &self.tools {

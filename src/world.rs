@@ -141,8 +141,11 @@ impl World {
             .ok_or(Error::UnknownBody(id.0))
     }
     /// Set the positions (m) and velocities (m/s) of every particle of a body, e.g. an initial
-    /// condition. Both slices must have one entry per particle and be finite; fixed particles
-    /// take the given position and zero velocity. Nothing changes on error.
+    /// condition. Both slices must have one entry per particle and be finite, within
+    /// [`STATE_POSITION_LIMIT`](crate::body::STATE_POSITION_LIMIT) body sizes of the body's
+    /// rest centre and below [`STATE_SPEED_LIMIT`](crate::body::STATE_SPEED_LIMIT) body sizes
+    /// per second; fixed particles take the given position and zero velocity. Nothing changes
+    /// on error.
     pub fn set_body_state(
         &mut self,
         id: BodyId,
@@ -164,6 +167,9 @@ impl World {
             .any(|v| !is_finite_vec(v))
         {
             return Err(Error::NonFinite("particle state".into()));
+        }
+        for (i, (x, v)) in positions.iter().zip(velocities).enumerate() {
+            body.check_state(i, x, v).map_err(Error::InvalidArgument)?;
         }
         body.x.copy_from_slice(positions);
         for ((v, given), fixed) in body.v.iter_mut().zip(velocities).zip(&body.fixed) {
@@ -397,8 +403,9 @@ impl World {
         })
     }
 
-    /// Advance the world by `settings.dt`. On NaN/Inf the world is rolled back and
-    /// [`Error::Diverged`] returned.
+    /// Advance the world by `settings.dt`. When a body becomes non-finite or leaves the
+    /// physical bounds of [`Settings::divergence`] the world is rolled back to the start of the
+    /// step and [`Error::Diverged`] says which body and why.
     pub fn step(&mut self) -> Result<StepReport, Error> {
         let (n, clamped) = self.substeps_needed();
         for b in &mut self.bodies {
@@ -415,7 +422,12 @@ impl World {
         for k in 1..=n {
             self.substep(h, k, n);
         }
-        if let Some((b, i)) = self.first_non_finite() {
+        let limits = self.settings.divergence;
+        let failure =
+            self.bodies.iter().enumerate().find_map(|(b, body)| {
+                crate::divergence::diverged(body, &limits).map(|why| (b, why))
+            });
+        if let Some((b, why)) = failure {
             for body in &mut self.bodies {
                 body.x.copy_from_slice(&body.saved_x);
                 body.v.copy_from_slice(&body.saved_v);
@@ -423,7 +435,8 @@ impl World {
             }
             self.diverged_steps += 1;
             return Err(Error::Diverged(format!(
-                "body {b} particle {i} became non-finite at t = {} s; reduce dt or stiffness",
+                "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
+                 restore a state, or reduce dt or the stiffness)",
                 self.time
             )));
         }
@@ -443,16 +456,6 @@ impl World {
         Ok(StepReport {
             substeps: n,
             substeps_clamped: clamped,
-        })
-    }
-
-    fn first_non_finite(&self) -> Option<(usize, usize)> {
-        self.bodies.iter().enumerate().find_map(|(b, body)| {
-            body.x
-                .iter()
-                .zip(&body.v)
-                .position(|(x, v)| !is_finite_vec(x) || !is_finite_vec(v))
-                .map(|i| (b, i))
         })
     }
 

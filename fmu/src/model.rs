@@ -207,10 +207,10 @@ pub static VARIABLES: &[Variable] = &[
         kind: Kind::Real {
             unit: "",
             start: Some(0.45),
-            min: Some(-1.0),
-            max: Some(0.5),
+            min: Some(tissuesim::body::MIN_POISSON_RATIO),
+            max: Some(tissuesim::body::MAX_POISSON_RATIO),
         },
-        description: "Poisson ratio nu of the organ, in (-1, 0.5)",
+        description: "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)",
     },
     param(vr::DENSITY, "density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
     param(vr::DAMPING, "damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),

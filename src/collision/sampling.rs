@@ -10,9 +10,15 @@ use parry3d_f64::math::Point;
 use parry3d_f64::shape::SharedShape;
 use std::f64::consts::PI;
 
+/// Largest number of surface samples (before removing duplicates on shared edges) a tool may
+/// get: 2 × 10⁶ points, 48 MB. A shape much larger than the sample spacing (or a spacing much
+/// smaller than the shape) is refused with a message instead of exhausting memory.
+pub const MAX_TOOL_SAMPLES: usize = 2_000_000;
+
 /// Sample the surface of `shape` (local frame) about `spacing` (m) apart. Returns the sample
-/// centres (m, local frame) and the radius of each sample sphere (m).
-pub fn sample_surface(shape: &SharedShape, spacing: Real) -> (Vec<Vec3>, Real) {
+/// centres (m, local frame) and the radius of each sample sphere (m), or a message when that
+/// would take more than [`MAX_TOOL_SAMPLES`] samples.
+pub fn sample_surface(shape: &SharedShape, spacing: Real) -> Result<(Vec<Vec3>, Real), String> {
     let aabb = shape.compute_local_aabb();
     let thinnest = aabb.half_extents().min();
     let radius = spacing.min(0.9 * thinnest);
@@ -37,7 +43,21 @@ pub fn sample_surface(shape: &SharedShape, spacing: Real) -> (Vec<Vec3>, Real) {
             (Vec::new(), Vec::new())
         };
     let centre = aabb.center().coords;
-    let mut samples: Vec<Vec3> = Vec::new();
+    // Count first (in floating point: no overflow), so that nothing huge is allocated.
+    let mut count: Real = 0.0;
+    for t in &triangles {
+        let [a, b, c] = t.map(|k| vertices[k as usize].coords);
+        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+        let m = (longest / spacing).ceil().max(1.0);
+        count += (m + 1.0) * (m + 2.0) / 2.0;
+    }
+    if count.is_nan() || count > MAX_TOOL_SAMPLES as Real {
+        return Err(format!(
+            "the tool surface needs about {count:.3e} samples at a sample spacing of {spacing:.3e} \
+             m (at most {MAX_TOOL_SAMPLES}): raise sample_spacing or use a smaller tool"
+        ));
+    }
+    let mut samples: Vec<Vec3> = Vec::with_capacity(count as usize);
     for t in &triangles {
         let [a, b, c] = t.map(|k| vertices[k as usize].coords);
         let mut normal = (b - a).cross(&(c - a));
@@ -67,5 +87,5 @@ pub fn sample_surface(shape: &SharedShape, spacing: Real) -> (Vec<Vec3>, Real) {
         (kp.x, kp.y, kp.z).cmp(&(kq.x, kq.y, kq.z))
     });
     samples.dedup_by(|p, q| key(p) == key(q));
-    (samples, radius)
+    Ok((samples, radius))
 }

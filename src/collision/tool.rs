@@ -252,6 +252,7 @@ impl Tool {
                         "tool triangle references a vertex out of range".into(),
                     ));
                 }
+                check_tool_mesh(vertices, triangles)?;
                 SharedShape::trimesh_with_flags(
                     to_points(vertices)?,
                     triangles.clone(),
@@ -266,7 +267,8 @@ impl Tool {
         let bounding_radius = aabb.center().coords.norm() + aabb.half_extents().norm();
         let spacing = options.sample_spacing.unwrap_or(default_spacing);
         positive("sample spacing", spacing)?;
-        let (samples, sample_radius) = crate::collision::sampling::sample_surface(&shape, spacing);
+        let (samples, sample_radius) = crate::collision::sampling::sample_surface(&shape, spacing)
+            .map_err(Error::InvalidArgument)?;
         Ok(Tool {
             description,
             shape,
@@ -325,6 +327,58 @@ impl Tool {
             d
         }
     }
+}
+
+/// Smallest accepted triangle area of a tool mesh, relative to the square of its bounding-box
+/// diagonal.
+pub const MIN_TOOL_TRIANGLE_AREA: Real = 1e-12;
+
+/// Smallest accepted thickness of a tool mesh (its thinnest bounding-box extent), relative to
+/// its bounding-box diagonal: a flat mesh encloses no volume and has no inside.
+pub const MIN_TOOL_THICKNESS: Real = 1e-6;
+
+/// Check a tool's triangle mesh (vertices finite and indices in range already checked): at
+/// least one triangle, no triangle of (near) zero area (repeated or collinear vertices), not
+/// flat. A degenerate mesh has no well-defined inside and poisons the contact query.
+pub fn check_tool_mesh(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::InvalidArgument(format!("tool mesh: {m}")));
+    if triangles.is_empty() || vertices.is_empty() {
+        return bad("no triangles".into());
+    }
+    let (mut lo, mut hi) = (vertices[0], vertices[0]);
+    for t in triangles {
+        for &k in t {
+            lo = lo.inf(&vertices[k as usize]);
+            hi = hi.sup(&vertices[k as usize]);
+        }
+    }
+    let diag = (hi - lo).norm();
+    if !(diag > 0.0 && diag.is_finite()) {
+        return bad(format!(
+            "all triangle vertices coincide (bounding-box diagonal {diag} m)"
+        ));
+    }
+    let min_area = MIN_TOOL_TRIANGLE_AREA * diag * diag;
+    for (i, t) in triangles.iter().enumerate() {
+        let [a, b, c] = t.map(|k| vertices[k as usize]);
+        let area = 0.5 * (b - a).cross(&(c - a)).norm();
+        if area.is_nan() || area <= min_area {
+            return bad(format!(
+                "triangle {i} (vertices {}, {}, {}) has zero area ({area:.3e} m2; at least \
+                 {MIN_TOOL_TRIANGLE_AREA:e} x the squared bounding-box diagonal is needed): \
+                 repeated or collinear vertices",
+                t[0], t[1], t[2]
+            ));
+        }
+    }
+    let thinnest = (hi - lo).min();
+    if thinnest < MIN_TOOL_THICKNESS * diag {
+        return bad(format!(
+            "the mesh is flat (thinnest extent {thinnest:.3e} m of a {diag:.3e} m bounding box): \
+             a tool needs a volume"
+        ));
+    }
+    Ok(())
 }
 
 /// Check a pair of friction coefficients: finite, ≥ 0, and μ_k ≤ μ_s.

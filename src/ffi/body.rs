@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 pub struct ts_material {
     /// Young's modulus E (Pa), > 0.
     pub youngs_modulus: f64,
-    /// Poisson ratio nu (dimensionless), in (-1, 0.5).
+    /// Poisson ratio nu (dimensionless), in [0, 0.49]: negative values are auxetic (not
+    /// tissue) and unstable here; the volumetric stiffness diverges as nu approaches 0.5.
     pub poisson_ratio: f64,
     /// Mass density rho (kg/m^3), > 0.
     pub density: f64,
@@ -34,10 +35,12 @@ pub struct ts_material {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ts_body_options {
     /// Support radius of every particle (m); 0 chooses one per particle automatically.
+    /// Otherwise in [0.5, 3] x the mesh's mean edge length (and at most 384 neighbours).
     pub support_radius: f64,
-    /// Contact radius of the particles (m); 0 derives it from the particle spacing.
+    /// Contact radius of the particles (m); 0 derives it from the particle spacing (half the
+    /// mean edge length). Otherwise in [0.05, 2] x the mesh's mean edge length.
     pub particle_radius: f64,
-    /// Target number of neighbours when the support radius is automatic (>= 1).
+    /// Target number of neighbours when the support radius is automatic (1..=96).
     pub target_neighbours: u32,
 }
 
@@ -77,17 +80,6 @@ unsafe fn body_options(
         &[m.youngs_modulus, m.poisson_ratio, m.density],
         "material (youngs_modulus, poisson_ratio, density)",
     )?;
-    positive(m.youngs_modulus, "material.youngs_modulus")?;
-    positive(m.density, "material.density")?;
-    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-        return Err(fail(
-            ts_status::InvalidArgument,
-            format!(
-                "material.poisson_ratio must be in (-1, 0.5) (got {})",
-                m.poisson_ratio
-            ),
-        ));
-    }
     let mut o = BodyOptions {
         material: Material {
             youngs_modulus: m.youngs_modulus,
@@ -103,21 +95,10 @@ unsafe fn body_options(
             &[c.support_radius, c.particle_radius],
             "options (support_radius, particle_radius)",
         )?;
-        let radius = |v: f64, name: &str| -> FfiResult<Option<f64>> {
-            if v == 0.0 {
-                Ok(None)
-            } else {
-                positive(v, name).map(|_| Some(v))
-            }
-        };
-        o.support_radius = radius(c.support_radius, "options.support_radius")?;
-        o.particle_radius = radius(c.particle_radius, "options.particle_radius")?;
-        if c.target_neighbours == 0 {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "options.target_neighbours must be >= 1",
-            ));
-        }
+        // 0 means automatic; every range is checked by the core (BodyOptions::check_radii).
+        let radius = |v: f64| (v != 0.0).then_some(v);
+        o.support_radius = radius(c.support_radius);
+        o.particle_radius = radius(c.particle_radius);
         o.target_neighbours = c.target_neighbours;
     }
     Ok(o)

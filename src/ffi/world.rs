@@ -6,7 +6,7 @@ use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::math::Vec3;
-use crate::settings::{ContactMode, Settings};
+use crate::settings::{ContactMode, DivergenceLimits, Settings};
 use crate::world::World;
 
 /// How tool-tissue contact is detected (the values of ts_settings.contact_mode).
@@ -39,7 +39,7 @@ pub struct ts_settings {
     pub damping_mass: f64,
     /// Stiffness-proportional damping time (s), >= 0.
     pub damping_stiffness: f64,
-    /// Hourglass-control stiffness (dimensionless, times Young's modulus), >= 0.
+    /// Hourglass-control stiffness (dimensionless, times the shear modulus mu), >= 0.
     pub hourglass_stiffness: f64,
     /// Compliance (1/Pa, per unit volume, >= 0) of the volume constraints in addition to the
     /// material's 1/lambda under the volumetric split (the default: 0 keeps the material's own
@@ -69,6 +69,19 @@ pub struct ts_settings {
     /// thread plus threads - 1 workers owned by the world. Results are bit-identical for any
     /// count.
     pub threads: u32,
+    /// Divergence check: largest particle speed, in body sizes per second (1/s, > 0; default
+    /// 250, i.e. 50 m/s for a 0.2 m organ). A step beyond it is rolled back and returns
+    /// TS_STATUS_DIVERGED. +infinity switches the check off.
+    pub divergence_max_speed: f64,
+    /// Divergence check: largest extent of a body (deformed bounding-box diagonal) over its
+    /// rest size (dimensionless, > 1; default 10). +infinity switches it off.
+    pub divergence_max_extent_ratio: f64,
+    /// Divergence check: smallest accepted body volume over rest volume (dimensionless, in
+    /// [0, 1); default 0.1).
+    pub divergence_min_volume_ratio: f64,
+    /// Divergence check: largest accepted body volume over rest volume (dimensionless, > 1;
+    /// default 10). +infinity switches it off.
+    pub divergence_max_volume_ratio: f64,
 }
 
 impl From<&Settings> for ts_settings {
@@ -94,6 +107,10 @@ impl From<&Settings> for ts_settings {
             mass_scaling: s.mass_scaling as u8,
             volumetric_split: s.volumetric_split as u8,
             threads: s.threads,
+            divergence_max_speed: s.divergence.max_speed,
+            divergence_max_extent_ratio: s.divergence.max_extent_ratio,
+            divergence_min_volume_ratio: s.divergence.volume_ratio.0,
+            divergence_max_volume_ratio: s.divergence.volume_ratio.1,
         }
     }
 }
@@ -117,6 +134,15 @@ impl ts_settings {
         ] {
             finite(v, name)?;
         }
+        // Infinity switches a divergence check off; NaN is refused by Settings::validate.
+        let divergence = DivergenceLimits {
+            max_speed: self.divergence_max_speed,
+            max_extent_ratio: self.divergence_max_extent_ratio,
+            volume_ratio: (
+                self.divergence_min_volume_ratio,
+                self.divergence_max_volume_ratio,
+            ),
+        };
         let contact_mode = match self.contact_mode {
             0 => ContactMode::ExactShape,
             1 => ContactMode::SampledPoints,
@@ -148,6 +174,7 @@ impl ts_settings {
             mass_scaling: self.mass_scaling != 0,
             volumetric_split: self.volumetric_split != 0,
             max_depenetration_speed: self.max_depenetration_speed,
+            divergence,
             ..Settings::default()
         };
         s.validate()?;

@@ -1,0 +1,409 @@
+//! "Robust under abuse": inputs a hostile host may pass must give a clear error, never an
+//! abort, a hang or a poisoned world. Each test reproduces one report of the issue.
+
+use std::sync::mpsc;
+use std::time::Duration;
+use tissuesim::mesh::{default_organ, lattice_box, TetMesh};
+use tissuesim::{
+    BodyOptions, ContactMode, Error, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3,
+    World,
+};
+
+/// Run `f` on its own thread; fail the test if it does not return within `secs` seconds.
+fn within<T: Send + 'static>(secs: u64, what: &str, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(Duration::from_secs(secs))
+        .unwrap_or_else(|_| panic!("{what} did not return within {secs} s"))
+}
+
+/// A 0.1 m cube of 4 × 4 × 4 cells (125 particles, cell 0.025 m).
+fn cube() -> TetMesh {
+    lattice_box(Vec3::repeat(-0.05), Vec3::repeat(0.05), [4, 4, 4])
+}
+
+fn invalid(r: Result<impl std::fmt::Debug, Error>, needle: &str) {
+    match r {
+        Err(Error::InvalidArgument(m)) => {
+            assert!(
+                m.contains(needle),
+                "message `{m}` should mention `{needle}`"
+            )
+        }
+        other => panic!("expected InvalidArgument mentioning `{needle}`, got {other:?}"),
+    }
+}
+
+#[test]
+fn tiny_and_huge_particle_radii_are_refused_with_a_message() {
+    for r in [1e-9, 5e-324, 1e3] {
+        let mut w = World::new(Settings::default()).unwrap();
+        let options = BodyOptions {
+            particle_radius: Some(r),
+            ..BodyOptions::default()
+        };
+        invalid(w.add_body(&cube(), &options), "particle_radius");
+    }
+}
+
+#[test]
+fn support_radius_far_above_the_spacing_is_refused() {
+    let mut w = World::new(Settings::default()).unwrap();
+    let options = BodyOptions {
+        support_radius: Some(1e3),
+        ..BodyOptions::default()
+    };
+    invalid(w.add_body(&cube(), &options), "support_radius");
+    let options = BodyOptions {
+        support_radius: Some(1e-6),
+        ..BodyOptions::default()
+    };
+    invalid(w.add_body(&cube(), &options), "support_radius");
+}
+
+#[test]
+fn poisson_ratios_outside_the_supported_range_are_refused() {
+    for nu in [-0.5, -0.999_999_99, -1e-3, 0.4999, 0.5, 0.7] {
+        let mut w = World::new(Settings::default()).unwrap();
+        let options = BodyOptions {
+            material: Material {
+                poisson_ratio: nu,
+                ..Material::default()
+            },
+            ..BodyOptions::default()
+        };
+        invalid(w.add_body(&cube(), &options), "Poisson ratio");
+    }
+    for nu in [0.0, 0.3, 0.45, 0.49] {
+        let m = Material {
+            poisson_ratio: nu,
+            ..Material::default()
+        };
+        assert!(m.validate().is_ok(), "nu {nu} is supported");
+    }
+}
+
+#[test]
+fn degenerate_tool_meshes_are_refused() {
+    let mut w = World::new(Settings::default()).unwrap();
+    w.add_body(&cube(), &BodyOptions::default()).unwrap();
+    let p = Vec3::new(0.3, 0.0, 0.0);
+    // All vertices equal.
+    let point = ToolShape::TriMesh {
+        vertices: vec![p; 4],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]],
+    };
+    invalid(
+        w.add_tool(point, Pose::at(Vec3::zeros()), &ToolOptions::default()),
+        "tool mesh",
+    );
+    // A tetrahedron surface plus one zero-area triangle (collinear vertices).
+    let v = vec![
+        Vec3::zeros(),
+        Vec3::new(0.01, 0.0, 0.0),
+        Vec3::new(0.0, 0.01, 0.0),
+        Vec3::new(0.0, 0.0, 0.01),
+        Vec3::new(0.02, 0.0, 0.0),
+    ];
+    let sliver = ToolShape::TriMesh {
+        vertices: v.clone(),
+        triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 4]],
+    };
+    invalid(
+        w.add_tool(sliver, Pose::at(Vec3::zeros()), &ToolOptions::default()),
+        "zero area",
+    );
+    // A flat mesh (two triangles in a plane): no volume.
+    let flat = ToolShape::TriMesh {
+        vertices: v[..3]
+            .iter()
+            .copied()
+            .chain([Vec3::new(0.01, 0.01, 0.0)])
+            .collect(),
+        triangles: vec![[0, 1, 2], [1, 3, 2]],
+    };
+    invalid(
+        w.add_tool(flat, Pose::at(Vec3::zeros()), &ToolOptions::default()),
+        "flat",
+    );
+    // The world still steps.
+    within(30, "step", move || w.step().map(|_| ())).unwrap();
+}
+
+#[test]
+fn tool_sample_counts_are_bounded() {
+    let settings = Settings {
+        contact_mode: ContactMode::SampledPoints,
+        ..Settings::default()
+    };
+    let r = within(30, "add_tool", move || {
+        let mut w = World::new(settings).unwrap();
+        w.add_body(&cube(), &BodyOptions::default()).unwrap();
+        let huge = ToolShape::Cuboid {
+            half_extents: Vec3::repeat(1e300),
+        };
+        let a = w.add_tool(huge, Pose::at(Vec3::zeros()), &ToolOptions::default());
+        let options = ToolOptions {
+            sample_spacing: Some(1e-9),
+            ..ToolOptions::default()
+        };
+        let b = w.add_tool(
+            ToolShape::Sphere { radius: 0.01 },
+            Pose::at(Vec3::zeros()),
+            &options,
+        );
+        (a.map(|_| ()), b.map(|_| ()))
+    });
+    invalid(r.0, "samples");
+    invalid(r.1, "samples");
+}
+
+fn organ_world(settings: Settings) -> World {
+    let mut w = World::new(settings).unwrap();
+    let b = w
+        .add_body(&default_organ(), &BodyOptions::default())
+        .unwrap();
+    w.fix_box(b, Vec3::new(-1.0, 0.04, -1.0), Vec3::repeat(1.0))
+        .unwrap();
+    w
+}
+
+#[test]
+fn restore_refuses_far_positions_and_huge_velocities() {
+    let mut w = World::new(Settings::default()).unwrap();
+    w.add_body(&cube(), &BodyOptions::default()).unwrap();
+    let mut good = Vec::new();
+    w.save_state(&mut good);
+    let header = 8 + 4 + 4 + 4 + 8 + 4;
+    let n = w.body(tissuesim::BodyId(0)).unwrap().particle_count();
+    for (offset, what) in [(0, "position"), (n * 24, "velocity")] {
+        let mut bad = good.clone();
+        let at = header + offset;
+        bad[at..at + 8].copy_from_slice(&1e300f64.to_le_bytes());
+        // Re-seal the checksum: a crafted state, not a corrupt one.
+        let body = bad.len() - 8;
+        let sum = fnv1a(&bad[..body]);
+        bad[body..].copy_from_slice(&sum.to_le_bytes());
+        match w.restore_state(&bad) {
+            Err(Error::BadState(m)) => assert!(m.contains(what), "{m}"),
+            other => panic!("crafted {what} 1e300 restored: {other:?}"),
+        }
+    }
+    w.restore_state(&good).unwrap();
+    within(30, "step", move || w.step().map(|_| ())).unwrap();
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+#[test]
+fn far_tool_poses_neither_hang_nor_poison() {
+    let mut w = organ_world(Settings::default());
+    let t = w
+        .add_tool(
+            ToolShape::Sphere { radius: 0.01 },
+            Pose::at(Vec3::new(0.0, 0.0, 0.2)),
+            &ToolOptions::default(),
+        )
+        .unwrap();
+    let w = within(60, "steps with far poses", move || {
+        for x in [1e300, -1e300, 1e12, 0.0] {
+            let _ = w.set_tool_pose(t, Pose::at(Vec3::new(x, 0.0, 0.2)));
+            let _ = w.step();
+        }
+        w
+    });
+    let _ = w;
+}
+
+/// Random far jumps (10 cm a step: 100 m/s) of a rough sphere inside the hanging organ. Every
+/// step either succeeds with the organ within the divergence limits or fails as `Diverged` and
+/// changes nothing; the world then steps again from the state saved before the abuse (a tangled
+/// organ within the limits may not recover by itself: restoring is the documented remedy).
+/// Returns the number of diverged steps.
+fn random_jumps(mode: ContactMode, steps: usize) -> u64 {
+    let settings = Settings {
+        contact_mode: mode,
+        ..Settings::default()
+    };
+    let limits = settings.divergence;
+    let mut w = organ_world(settings);
+    let options = ToolOptions {
+        friction_static: 1.0,
+        friction_kinetic: 1.0,
+        ..ToolOptions::default()
+    };
+    let away = Pose::at(Vec3::new(0.0, 0.0, 0.3));
+    let t = w
+        .add_tool(ToolShape::Sphere { radius: 0.015 }, away, &options)
+        .unwrap();
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+    };
+    let b = tissuesim::BodyId(0);
+    let (mut start, mut before, mut after) = (Vec::new(), Vec::new(), Vec::new());
+    w.save_state(&mut start);
+    for _ in 0..steps {
+        let p = Vec3::new(0.1 * rnd(), 0.05 * rnd(), 0.07 * rnd());
+        w.set_tool_pose(t, Pose::at(p)).unwrap();
+        before.clear();
+        w.save_state(&mut before);
+        match w.step() {
+            Ok(_) => {
+                let body = w.body(b).unwrap();
+                let r = body.volume_ratio();
+                assert!(
+                    (limits.volume_ratio.0..=limits.volume_ratio.1).contains(&r),
+                    "{mode:?}: a step returned OK with a volume ratio of {r}"
+                );
+            }
+            Err(Error::Diverged(_)) => {
+                after.clear();
+                w.save_state(&mut after);
+                assert!(
+                    before == after,
+                    "{mode:?}: a diverged step changed the world"
+                );
+            }
+            Err(e) => panic!("{mode:?}: {e}"),
+        }
+    }
+    w.restore_state(&start).unwrap();
+    assert_eq!(w.tool(t).unwrap().pose(), away);
+    for k in 0..50 {
+        if let Err(e) = w.step() {
+            panic!("{mode:?}: step {k} after restoring the state: {e}");
+        }
+    }
+    w.diverged_steps()
+}
+
+#[test]
+fn random_far_jumps_are_reported_and_the_world_stays_usable() {
+    for mode in [ContactMode::ExactShape, ContactMode::SampledPoints] {
+        let diverged = random_jumps(mode, 600);
+        println!("{mode:?}: {diverged} of 600 steps diverged and were rolled back");
+    }
+}
+
+#[test]
+fn rotation_of_an_overflowing_deformation_gradient_returns() {
+    use tissuesim::Mat3;
+    for f in [
+        Mat3::from_element(1e300),
+        Mat3::new(1e300, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1e300),
+        Mat3::from_element(Real::MIN_POSITIVE),
+    ] {
+        let q = within(10, "rotation_from_svd", move || {
+            tissuesim::elastic::rotation_from_svd(&f)
+        });
+        assert!(q.coords.iter().all(|c| c.is_finite()));
+    }
+}
+
+/// Step a 0.1 m cube from the state (`x`, `v`) under `limits`: the step must fail as
+/// `Diverged` with a message containing `why`, be counted and rolled back, and the world must
+/// step on from a sane state afterwards.
+fn explodes(limits: tissuesim::DivergenceLimits, x: &[Vec3], v: &[Vec3], why: &str) {
+    let mut w = World::new(Settings {
+        divergence: limits,
+        ..Settings::default()
+    })
+    .unwrap();
+    let b = w.add_body(&cube(), &BodyOptions::default()).unwrap();
+    let rest = w.body(b).unwrap().positions().to_vec();
+    w.set_body_state(b, x, v).unwrap();
+    match w.step() {
+        Err(Error::Diverged(m)) => assert!(m.contains(why), "{m}"),
+        other => panic!("expected Diverged ({why}), got {other:?}"),
+    }
+    assert_eq!(w.diverged_steps(), 1);
+    assert_eq!(w.body(b).unwrap().positions(), x, "rolled back");
+    assert_eq!(w.body(b).unwrap().velocities(), v, "rolled back");
+    w.set_body_state(b, &rest, &vec![Vec3::zeros(); rest.len()])
+        .unwrap();
+    w.step().unwrap();
+}
+
+/// A finite explosion (a particle too fast, a body flown apart) is reported as `Diverged` with
+/// the reason, the step is rolled back, and the world steps on once the state is sane again.
+#[test]
+fn finite_explosions_are_rolled_back_and_reported() {
+    use tissuesim::DivergenceLimits;
+    let rest = cube().nodes;
+    let size = 0.1 * 3.0f64.sqrt();
+    let still = vec![Vec3::zeros(); rest.len()];
+    // One particle at 500 body sizes per second (accepted as a state, beyond the step's 250).
+    let mut fast = still.clone();
+    fast[7] = Vec3::new(500.0 * size, 0.0, 0.0);
+    explodes(DivergenceLimits::default(), &rest, &fast, "moves at");
+    // Spread to 9.9 times its size and flying apart (the extent crosses 10 within the step);
+    // the speed check off, or it would fire first.
+    let spread: Vec<Vec3> = rest.iter().map(|x| x * 9.9).collect();
+    let outwards: Vec<Vec3> = spread.iter().map(|x| x * 100.0).collect();
+    let no_speed = DivergenceLimits {
+        max_speed: Real::INFINITY,
+        ..Default::default()
+    };
+    explodes(no_speed, &spread, &outwards, "spans");
+    // Squashed to 12% of its height and still being squashed (the volume ratio crosses 0.1).
+    let flat: Vec<Vec3> = rest
+        .iter()
+        .map(|x| Vec3::new(x.x, 0.12 * x.y, x.z))
+        .collect();
+    let squashing: Vec<Vec3> = flat
+        .iter()
+        .map(|x| Vec3::new(0.0, -400.0 * x.y, 0.0))
+        .collect();
+    let volume_only = DivergenceLimits {
+        max_extent_ratio: Real::INFINITY,
+        ..no_speed
+    };
+    explodes(volume_only, &flat, &squashing, "volume");
+    // A body set outside the bounds but recovering is not diverging:
+    // A body squashed to 5% of its height (volume ratio 0.05) and at rest springs back.
+    let mut w = World::new(Settings::default()).unwrap();
+    let b = w.add_body(&cube(), &BodyOptions::default()).unwrap();
+    let flatter: Vec<Vec3> = rest
+        .iter()
+        .map(|x| Vec3::new(x.x, 0.05 * x.y, x.z))
+        .collect();
+    w.set_body_state(b, &flatter, &still).unwrap();
+    for _ in 0..10 {
+        w.step().unwrap();
+    }
+    assert!(w.body(b).unwrap().volume_ratio() > 0.05);
+    // Switched off, the same fast particle steps (and flies).
+    let mut w = World::new(Settings {
+        divergence: no_speed,
+        ..Settings::default()
+    })
+    .unwrap();
+    let b = w.add_body(&cube(), &BodyOptions::default()).unwrap();
+    w.set_body_state(b, &rest, &fast).unwrap();
+    w.step().unwrap();
+    let nan = DivergenceLimits {
+        max_speed: Real::NAN,
+        ..Default::default()
+    };
+    invalid(
+        World::new(Settings {
+            divergence: nan,
+            ..Settings::default()
+        })
+        .map(|_| ()),
+        "divergence",
+    );
+}
