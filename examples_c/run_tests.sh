@@ -2,7 +2,8 @@
 # Build the release library, check that the header compiles cleanly as C99, C11, C++11 and C++17
 # (header_check.c), compile every C program in examples_c/ and the C++17 example hello_cpp.cpp
 # against the shared library (and test_api.c also against the static one), run them, then run
-# them again under valgrind (no errors, no definite/indirect leaks). Prints "N passed, M failed"
+# them again under valgrind (no errors, no definite/indirect leaks); the hostile client hostile.c
+# also runs built with -fsanitize=address,undefined. Prints "N passed, M failed"
 # last; exits non-zero on any failure.
 #
 #   examples_c/run_tests.sh            from anywhere in the repository
@@ -65,7 +66,7 @@ fi
 
 # Binaries of an earlier run must not stand in for ones that fail to compile now.
 rm -f "$OUT"/header_check_* "$OUT"/hello "$OUT"/hello_cpp "$OUT"/haptic_loop "$OUT"/sofa_liver \
-    "$OUT"/test_api "$OUT"/test_api_static
+    "$OUT"/test_api "$OUT"/test_api_static "$OUT"/hostile "$OUT"/hostile_asan
 
 echo "== compiling the header as C and C++ (header_check.c)"
 for std in c99 c11; do
@@ -99,6 +100,20 @@ if "$CC" "${CFLAGS[@]}" examples_c/test_api.c "$LIB_DIR/libtissuesim.a" -lpthrea
     pass "compile test_api.c (static)"
 else
     fail "compile test_api.c (static)"
+fi
+if "$CC" "${CFLAGS[@]}" examples_c/hostile.c -L"$LIB_DIR" -ltissuesim -lpthread -lm \
+    -o "$OUT/hostile"; then
+    pass "compile hostile.c (shared)"
+else
+    fail "compile hostile.c (shared)"
+fi
+# The hostile client again with AddressSanitizer and UndefinedBehaviorSanitizer on the C side
+# (the Rust library is checked by its own tests; ASan also sees its heap through malloc).
+if "$CC" "${CFLAGS[@]}" -fsanitize=address,undefined -fno-omit-frame-pointer \
+    examples_c/hostile.c -L"$LIB_DIR" -ltissuesim -lpthread -lm -o "$OUT/hostile_asan"; then
+    pass "compile hostile.c (-fsanitize=address,undefined)"
+else
+    fail "compile hostile.c (-fsanitize=address,undefined)"
 fi
 if "$CXX" "${CXXFLAGS[@]}" examples_c/hello_cpp.cpp -L"$LIB_DIR" -ltissuesim -o "$OUT/hello_cpp"; then
     pass "compile hello_cpp.cpp (C++17, shared)"
@@ -140,6 +155,9 @@ else
 fi
 [ -x "$OUT/test_api" ] && run test_api -- "$OUT/test_api"
 [ -x "$OUT/test_api_static" ] && run test_api_static -- "$OUT/test_api_static"
+[ -x "$OUT/hostile" ] && run hostile -- "$OUT/hostile"
+[ -x "$OUT/hostile_asan" ] && run hostile_asan ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 -- "$OUT/hostile_asan"
 
 if [ "${SKIP_VALGRIND:-0}" = 1 ]; then
     echo "SKIP valgrind (SKIP_VALGRIND=1)"
@@ -174,5 +192,6 @@ fi
 [ -x "$OUT/test_api" ] && run valgrind-test_api TS_STEPS=3 -- "${VG[@]}" "$OUT/test_api"
 [ -x "$OUT/test_api_static" ] && run valgrind-test_api_static TS_STEPS=3 -- \
     "${VG[@]}" "$OUT/test_api_static"
+[ -x "$OUT/hostile" ] && run valgrind-hostile -- "${VG[@]}" "$OUT/hostile"
 
 finish

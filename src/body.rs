@@ -33,14 +33,25 @@ pub const MIN_POISSON_RATIO: Real = 0.0;
 /// See [`MIN_POISSON_RATIO`].
 pub const MAX_POISSON_RATIO: Real = 0.49;
 
+/// Accepted Young's moduli (Pa): from 10⁻⁶ Pa (far softer than any tissue, and well above the
+/// denormal numbers, whose arithmetic is slow and loses precision) to 10¹² Pa (stiffer than
+/// diamond; beyond it stresses overflow long before the explicit step could resolve them).
+pub const YOUNGS_MODULUS_RANGE: (Real, Real) = (1e-6, 1e12);
+
+/// Accepted densities (kg/m³): from 10⁻⁶ (models in mesh units use ρ = 1) to 10⁵ (four times
+/// osmium, the densest element).
+pub const DENSITY_RANGE: (Real, Real) = (1e-6, 1e5);
+
 impl Material {
-    /// Check the material: E > 0 Pa, ν in [[`MIN_POISSON_RATIO`], [`MAX_POISSON_RATIO`]],
-    /// ρ > 0 kg/m³, all finite. The message names the field, the range and why.
+    /// Check the material: E in [`YOUNGS_MODULUS_RANGE`], ν in [[`MIN_POISSON_RATIO`],
+    /// [`MAX_POISSON_RATIO`]], ρ in [`DENSITY_RANGE`]. The message names the field, the range
+    /// and why.
     pub fn validate(&self) -> Result<(), Error> {
         let bad = |s: String| Err(Error::InvalidArgument(s));
-        if !(self.youngs_modulus.is_finite() && self.youngs_modulus > 0.0) {
+        let (e_lo, e_hi) = YOUNGS_MODULUS_RANGE;
+        if !(e_lo..=e_hi).contains(&self.youngs_modulus) {
             return bad(format!(
-                "Young's modulus must be finite and > 0 Pa, got {}",
+                "Young's modulus must be in [{e_lo:e}, {e_hi:e}] Pa, got {:e}",
                 self.youngs_modulus
             ));
         }
@@ -52,9 +63,10 @@ impl Material {
                  stiffness lambda = E nu / ((1 + nu)(1 - 2 nu)) diverges as nu -> 0.5"
             ));
         }
-        if !(self.density.is_finite() && self.density > 0.0) {
+        let (d_lo, d_hi) = DENSITY_RANGE;
+        if !(d_lo..=d_hi).contains(&self.density) {
             return bad(format!(
-                "density must be finite and > 0 kg/m3, got {}",
+                "density must be in [{d_lo:e}, {d_hi:e}] kg/m3, got {:e}",
                 self.density
             ));
         }

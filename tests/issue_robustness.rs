@@ -141,12 +141,18 @@ fn tool_sample_counts_are_bounded() {
     let r = within(30, "add_tool", move || {
         let mut w = World::new(settings).unwrap();
         w.add_body(&cube(), &BodyOptions::default()).unwrap();
-        let huge = ToolShape::Cuboid {
+        let absurd = ToolShape::Cuboid {
             half_extents: Vec3::repeat(1e300),
+        };
+        let too_big = w.add_tool(absurd, Pose::at(Vec3::zeros()), &ToolOptions::default());
+        invalid(too_big.map(|_| ()), "half extent");
+        // 200 m across: a legal size, but ~10^9 samples at the default spacing.
+        let huge = ToolShape::Cuboid {
+            half_extents: Vec3::repeat(100.0),
         };
         let a = w.add_tool(huge, Pose::at(Vec3::zeros()), &ToolOptions::default());
         let options = ToolOptions {
-            sample_spacing: Some(1e-9),
+            sample_spacing: Some(2e-6),
             ..ToolOptions::default()
         };
         let b = w.add_tool(

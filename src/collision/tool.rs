@@ -195,11 +195,12 @@ impl Tool {
         }
         check_friction(options.friction_static, options.friction_kinetic)?;
         let positive = |name: &str, v: Real| {
-            if v.is_finite() && v > 0.0 {
+            let (lo, hi) = TOOL_SIZE_RANGE;
+            if (lo..=hi).contains(&v) {
                 Ok(())
             } else {
                 Err(Error::InvalidArgument(format!(
-                    "tool {name} must be finite and > 0 m, got {v}"
+                    "tool {name} must be in [{lo:e}, {hi:e}] m, got {v:e}"
                 )))
             }
         };
@@ -328,6 +329,11 @@ impl Tool {
         }
     }
 }
+
+/// Accepted range (m) of a tool's radii, half heights, half extents and sample spacing: from a
+/// micrometre (finer than any instrument, and far above denormal numbers) to a kilometre
+/// (beyond it the contact arithmetic loses every digit of a millimetre).
+pub const TOOL_SIZE_RANGE: (Real, Real) = (1e-6, 1e3);
 
 /// Smallest accepted triangle area of a tool mesh, relative to the square of its bounding-box
 /// diagonal.
