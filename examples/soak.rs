@@ -71,13 +71,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(s) => s.parse()?,
         None => 1_000_000,
     };
-    let phases: Vec<(ContactMode, (&str, ToolShape))> = [
-        ContactMode::ExactShape,
-        ContactMode::SampledPoints,
-    ]
-    .into_iter()
-    .flat_map(|m| shapes().into_iter().map(move |s| (m, s)))
-    .collect();
+    let phases: Vec<(ContactMode, (&str, ToolShape))> =
+        [ContactMode::ExactShape, ContactMode::SampledPoints]
+            .into_iter()
+            .flat_map(|m| shapes().into_iter().map(move |s| (m, s)))
+            .collect();
     let per_phase = (total / phases.len() as u64).max(1);
     let mut rng = Rng(0x50a4_2026);
     let (mut all_steps, mut all_diverged, mut escaped) = (0u64, 0u64, 0u64);
@@ -138,7 +136,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             if step % 10_000 == 9_999 {
                 let body = w.body(b)?;
-                if body.positions().iter().any(|x| !x.iter().all(|c| c.is_finite())) {
+                if body
+                    .positions()
+                    .iter()
+                    .any(|x| !x.iter().all(|c| c.is_finite()))
+                {
                     escaped += 1;
                 }
                 saved.clear();
