@@ -3,7 +3,7 @@
 
 use crate::consistency;
 use crate::elastic::{self, ElasticModel, ForceInputs};
-use crate::error::Error;
+use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
@@ -22,6 +22,20 @@ pub struct Material {
 }
 
 impl Material {
+    /// Check the material: NaN or ±Inf give [`Error::NonFinite`]; E ≤ 0, ν outside (-1, 0.5)
+    /// or ρ ≤ 0 give [`Error::InvalidArgument`]. The one validation of materials, used when a
+    /// body is built and by the C API.
+    pub fn validate(&self) -> Result<(), Error> {
+        check_positive("material.youngs_modulus", self.youngs_modulus, "Pa")?;
+        check_finite("material.poisson_ratio", self.poisson_ratio)?;
+        if !(self.poisson_ratio > -1.0 && self.poisson_ratio < 0.5) {
+            return Err(Error::InvalidArgument(format!(
+                "material.poisson_ratio must be in (-1, 0.5), got {}",
+                self.poisson_ratio
+            )));
+        }
+        check_positive("material.density", self.density, "kg/m3")
+    }
     /// First Lamé parameter λ = Eν / ((1 + ν)(1 - 2ν)) (Pa): under the volumetric split the
     /// volume constraints get compliance `1/λ`.
     pub fn lame_lambda(&self) -> Real {
@@ -63,6 +77,27 @@ pub struct BodyOptions {
     /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
     /// gradients of the paper (for comparison only).
     pub consistent_gradients: bool,
+}
+
+impl BodyOptions {
+    /// Check the options: the material ([`Material::validate`]), radii finite and > 0 m when
+    /// given, `target_neighbours` ≥ 1. NaN or ±Inf give [`Error::NonFinite`], other bad values
+    /// [`Error::InvalidArgument`]. Used when a body is built and by the C API.
+    pub fn validate(&self) -> Result<(), Error> {
+        self.material.validate()?;
+        if let Some(r) = self.support_radius {
+            check_positive("options.support_radius", r, "m")?;
+        }
+        if let Some(r) = self.particle_radius {
+            check_positive("options.particle_radius", r, "m")?;
+        }
+        if self.target_neighbours == 0 {
+            return Err(Error::InvalidArgument(
+                "options.target_neighbours must be >= 1".into(),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for BodyOptions {
@@ -144,31 +179,9 @@ impl Body {
         options: &BodyOptions,
         settings: &Settings,
     ) -> Result<Body, Error> {
+        options.validate()?;
         let m = &options.material;
         let bad = |s: String| Err(Error::InvalidArgument(s));
-        if !(m.youngs_modulus.is_finite() && m.youngs_modulus > 0.0) {
-            return bad(format!(
-                "Young's modulus must be > 0 Pa, got {}",
-                m.youngs_modulus
-            ));
-        }
-        if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-            return bad(format!(
-                "Poisson ratio must be in (-1, 0.5), got {}",
-                m.poisson_ratio
-            ));
-        }
-        if !(m.density.is_finite() && m.density > 0.0) {
-            return bad(format!("density must be > 0 kg/m3, got {}", m.density));
-        }
-        for r in [options.support_radius, options.particle_radius]
-            .into_iter()
-            .flatten()
-        {
-            if !(r.is_finite() && r > 0.0) {
-                return bad(format!("radii must be finite and > 0 m, got {r}"));
-            }
-        }
         let n = mesh.nodes.len();
         if mesh.tets.is_empty() || n < 5 {
             return bad("a body needs at least one tetrahedron and 5 nodes".into());
