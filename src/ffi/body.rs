@@ -3,8 +3,7 @@
 
 use crate::body::{Body, BodyOptions, Material};
 use crate::ffi::args::{
-    all_finite, element_count, input_slice, non_null, positive, read_vec3, world_mut, world_ref,
-    write,
+    all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,
 };
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
@@ -61,7 +60,8 @@ impl From<&BodyOptions> for ts_body_options {
     }
 }
 
-/// The Rust body options from the C material and (optional) options.
+/// The Rust body options from the C material and (optional) options, checked by
+/// [`BodyOptions::validate`] (the one validation of materials and body options).
 ///
 /// # Safety
 ///
@@ -73,21 +73,6 @@ unsafe fn body_options(
     non_null(material, "material")?;
     // SAFETY: checked non-NULL, readable by contract; any bit pattern is a valid value.
     let m = unsafe { *material };
-    all_finite(
-        &[m.youngs_modulus, m.poisson_ratio, m.density],
-        "material (youngs_modulus, poisson_ratio, density)",
-    )?;
-    positive(m.youngs_modulus, "material.youngs_modulus")?;
-    positive(m.density, "material.density")?;
-    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
-        return Err(fail(
-            ts_status::InvalidArgument,
-            format!(
-                "material.poisson_ratio must be in (-1, 0.5) (got {})",
-                m.poisson_ratio
-            ),
-        ));
-    }
     let mut o = BodyOptions {
         material: Material {
             youngs_modulus: m.youngs_modulus,
@@ -99,27 +84,13 @@ unsafe fn body_options(
     if !options.is_null() {
         // SAFETY: non-NULL, readable by contract.
         let c = unsafe { *options };
-        all_finite(
-            &[c.support_radius, c.particle_radius],
-            "options (support_radius, particle_radius)",
-        )?;
-        let radius = |v: f64, name: &str| -> FfiResult<Option<f64>> {
-            if v == 0.0 {
-                Ok(None)
-            } else {
-                positive(v, name).map(|_| Some(v))
-            }
-        };
-        o.support_radius = radius(c.support_radius, "options.support_radius")?;
-        o.particle_radius = radius(c.particle_radius, "options.particle_radius")?;
-        if c.target_neighbours == 0 {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "options.target_neighbours must be >= 1",
-            ));
-        }
+        // 0 means automatic; any other value is given to the core, which validates it.
+        let radius = |v: f64| (v != 0.0).then_some(v);
+        o.support_radius = radius(c.support_radius);
+        o.particle_radius = radius(c.particle_radius);
         o.target_neighbours = c.target_neighbours;
     }
+    o.validate()?;
     Ok(o)
 }
 
@@ -234,7 +205,7 @@ pub unsafe extern "C" fn ts_world_add_body_from_file(
         let o = unsafe { body_options(material, options)? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
-        positive(scale, "scale")?;
+        mesh::validate_scale(scale)?;
         let (mesh, report) = mesh::load(&path, scale)?;
         let id = h.add_mesh(&mesh, report.original_node_index, &o)?;
         // SAFETY: checked non-NULL.
@@ -341,13 +312,6 @@ pub unsafe extern "C" fn ts_body_fix_particles(
         let idx = unsafe { input_slice(indices, count, "indices")? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
-        let n = h.body(body)?.particle_count();
-        if let Some(bad) = idx.iter().find(|&&i| i as usize >= n) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                format!("indices: particle {bad} out of range (body {body} has {n} particles)"),
-            ));
-        }
         h.mutate(|w| w.fix_particles(BodyId(body), idx))
     })
 }
@@ -375,15 +339,6 @@ pub unsafe extern "C" fn ts_body_fix_box(
         let h = unsafe { world_mut(world)? };
         // SAFETY: checked non-NULL; 3 doubles each by contract.
         let (lo, hi) = unsafe { (read_vec3(min), read_vec3(max)) };
-        all_finite(lo.as_slice(), "min")?;
-        all_finite(hi.as_slice(), "max")?;
-        if (0..3).any(|k| lo[k] > hi[k]) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "min must be <= max on every axis",
-            ));
-        }
-        h.body(body)?;
         let n = h.mutate(|w| w.fix_box(BodyId(body), lo, hi))?;
         if !out_fixed.is_null() {
             // SAFETY: non-NULL, writable by contract.

@@ -2,16 +2,14 @@
 //! and the contact wrench the tissue exerts on them.
 
 use crate::collision::tool::{Pose, ToolOptions, ToolShape};
-use crate::ffi::args::{all_finite, non_negative, non_null, positive, world_mut, world_ref, write};
+use crate::ffi::args::{non_null, world_mut, world_ref, write};
 use crate::ffi::body::c_path;
-use crate::ffi::error::{fail, FfiResult};
+use crate::ffi::error::FfiResult;
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::{Quat, Vec3};
 use crate::mesh;
 use crate::world::ToolId;
-use nalgebra::Quaternion;
 use std::ffi::c_char;
 
 /// A rigid pose in the world frame: the position of the tool origin and its orientation.
@@ -26,24 +24,10 @@ pub struct ts_pose {
 }
 
 impl ts_pose {
-    /// The Rust pose: NaN/Inf give TS_STATUS_NON_FINITE, a zero quaternion
-    /// TS_STATUS_INVALID_ARGUMENT; the quaternion is normalised.
+    /// The Rust pose by [`Pose::from_components`] (the one quaternion check and normalisation):
+    /// NaN/Inf give TS_STATUS_NON_FINITE, a (near) zero quaternion TS_STATUS_INVALID_ARGUMENT.
     pub fn to_pose(&self) -> FfiResult<Pose> {
-        all_finite(&self.position, "pose.position")?;
-        all_finite(&self.orientation, "pose.orientation")?;
-        let [w, x, y, z] = self.orientation;
-        let q = Quaternion::new(w, x, y, z);
-        let norm = q.norm();
-        if !(norm.is_finite() && norm > 1e-12) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "pose.orientation: the quaternion must not be zero",
-            ));
-        }
-        Ok(Pose {
-            position: Vec3::new(self.position[0], self.position[1], self.position[2]),
-            orientation: Quat::new_unchecked(q / norm),
-        })
+        Ok(Pose::from_components(self.position, self.orientation)?)
     }
 }
 
@@ -81,22 +65,16 @@ impl From<&ToolOptions> for ts_tool_options {
 }
 
 impl ts_tool_options {
-    /// The Rust options, checked.
+    /// The Rust options (sample_spacing 0 means automatic), checked by
+    /// [`ToolOptions::validate`].
     pub fn to_options(&self) -> FfiResult<ToolOptions> {
-        non_negative(self.friction_static, "options.friction_static")?;
-        non_negative(self.friction_kinetic, "options.friction_kinetic")?;
-        non_negative(self.sample_spacing, "options.sample_spacing")?;
-        if self.friction_kinetic > self.friction_static {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "options.friction_kinetic must be <= options.friction_static",
-            ));
-        }
-        Ok(ToolOptions {
+        let o = ToolOptions {
             friction_static: self.friction_static,
             friction_kinetic: self.friction_kinetic,
-            sample_spacing: (self.sample_spacing > 0.0).then_some(self.sample_spacing),
-        })
+            sample_spacing: (self.sample_spacing != 0.0).then_some(self.sample_spacing),
+        };
+        o.validate()?;
+        Ok(o)
     }
 }
 
@@ -114,7 +92,8 @@ pub struct ts_wrench {
     pub contact_count: u32,
 }
 
-/// Add a tool of `shape` after checking the common arguments.
+/// Add a tool of `shape` (built after the pose and options are converted and checked, so that
+/// a bad pose fails before a file is read); every value is checked by the core.
 ///
 /// # Safety
 ///
@@ -177,16 +156,14 @@ pub unsafe extern "C" fn ts_world_add_tool_sphere(
     options: *const ts_tool_options,
     out_tool: *mut u32,
 ) -> ts_status {
-    let shape = || {
-        positive(radius, "radius")?;
-        Ok(ToolShape::Sphere { radius })
-    };
+    let shape = || Ok(ToolShape::Sphere { radius });
     // SAFETY: contract of this function.
     unsafe { add_tool(world, shape, pose, options, out_tool) }
 }
 
-/// Add a capsule tool along its local y axis: `half_height` (m, >= 0) is half the distance
-/// between the hemisphere centres, `radius` (m, > 0). Otherwise as ts_world_add_tool_sphere.
+/// Add a capsule tool along its local y axis: `half_height` (m, >= 0; 0 gives a sphere) is half
+/// the distance between the hemisphere centres, `radius` (m, > 0). Otherwise as
+/// ts_world_add_tool_sphere.
 ///
 /// # Safety
 ///
@@ -201,8 +178,6 @@ pub unsafe extern "C" fn ts_world_add_tool_capsule(
     out_tool: *mut u32,
 ) -> ts_status {
     let shape = || {
-        non_negative(half_height, "half_height")?;
-        positive(radius, "radius")?;
         Ok(ToolShape::Capsule {
             half_height,
             radius,
@@ -228,8 +203,6 @@ pub unsafe extern "C" fn ts_world_add_tool_cylinder(
     out_tool: *mut u32,
 ) -> ts_status {
     let shape = || {
-        positive(half_height, "half_height")?;
-        positive(radius, "radius")?;
         Ok(ToolShape::Cylinder {
             half_height,
             radius,
@@ -259,9 +232,6 @@ pub unsafe extern "C" fn ts_world_add_tool_box(
     let shape = || {
         // SAFETY: non-NULL, 3 readable doubles by contract.
         let e = unsafe { crate::ffi::args::read_vec3(half_extents) };
-        for k in 0..3 {
-            positive(e[k], &format!("half_extents[{k}]"))?;
-        }
         Ok(ToolShape::Cuboid { half_extents: e })
     };
     // SAFETY: contract of this function.
@@ -291,7 +261,7 @@ pub unsafe extern "C" fn ts_world_add_tool_mesh_file(
     let shape = || {
         // SAFETY: non-NULL and NUL-terminated by contract.
         let path = unsafe { c_path(path, "path")? };
-        positive(scale, "scale")?;
+        mesh::validate_scale(scale)?;
         let surface = mesh::read_obj(&path, scale)?;
         Ok(ToolShape::TriMesh {
             vertices: surface.vertices,
