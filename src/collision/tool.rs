@@ -144,6 +144,9 @@ fn check_hull_points(points: &[Vec3]) -> Result<(), Error> {
     Ok(())
 }
 
+/// Quaternions of a smaller norm are rejected as zero by [`Pose::from_components`].
+pub const MIN_QUATERNION_NORM: Real = 1e-12;
+
 /// A rigid pose: position (m) of the tool origin and orientation, both in the world frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pose {
@@ -162,8 +165,9 @@ impl Pose {
         }
     }
 
-    /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised on use.
-    /// Rejects NaN/Inf and a (near) zero quaternion.
+    /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised here. NaN/Inf give
+    /// [`Error::NonFinite`], a quaternion of norm below [`MIN_QUATERNION_NORM`]
+    /// [`Error::InvalidArgument`]. The one conversion of raw poses (the C API uses it too).
     pub fn from_components(position: [Real; 3], quaternion: [Real; 4]) -> Result<Self, Error> {
         let p = Vec3::from(position);
         if !is_finite_vec(&p) || quaternion.iter().any(|c| !c.is_finite()) {
@@ -172,7 +176,7 @@ impl Pose {
         let [w, x, y, z] = quaternion;
         let q = nalgebra::Quaternion::new(w, x, y, z);
         let norm = q.norm();
-        if norm < 1e-12 {
+        if norm < MIN_QUATERNION_NORM {
             return Err(Error::InvalidArgument(
                 "tool orientation: zero quaternion".into(),
             ));

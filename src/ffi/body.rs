@@ -714,3 +714,124 @@ pub unsafe extern "C" fn ts_body_mass(
     // SAFETY: contract of this function.
     unsafe { body_value(world, body, out_mass, |b| b.mass()) }
 }
+
+/// Set the positions and velocities of every particle of a body, e.g. an initial condition or
+/// a reset: `positions` holds particle_count x 3 doubles (m, world frame), `velocities`
+/// particle_count x 3 doubles (m/s); `positions_len` and `velocities_len` are their lengths in
+/// doubles and must both be 3 * particle_count (else TS_STATUS_INVALID_ARGUMENT). NaN/Inf give
+/// TS_STATUS_NON_FINITE. Fixed particles take the given position and zero velocity (and stay
+/// fixed there). Nothing changes on error. Allocates (not for every haptic frame).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `positions` is NULL or holds `positions_len` readable
+/// doubles; `velocities` is NULL or holds `velocities_len` readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_set_state(
+    world: *mut ts_world,
+    body: u32,
+    positions: *const f64,
+    positions_len: usize,
+    velocities: *const f64,
+    velocities_len: usize,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let x = unsafe { input_slice(positions, positions_len, "positions")? };
+        // SAFETY: contract of this function.
+        let v = unsafe { input_slice(velocities, velocities_len, "velocities")? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        let vectors = |xyz: &[f64], name: &str| -> FfiResult<Vec<Vec3>> {
+            if xyz.len() % 3 != 0 {
+                return Err(fail(
+                    ts_status::InvalidArgument,
+                    format!("{name}_len {} is not a multiple of 3", xyz.len()),
+                ));
+            }
+            Ok(xyz
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect())
+        };
+        let (x, v) = (vectors(x, "positions")?, vectors(v, "velocities")?);
+        h.mutate(|w| w.set_body_state(BodyId(body), &x, &v))
+    })
+}
+
+/// Whether each particle is fixed (1) or free (0) into `out`: particle_count bytes. `len` in
+/// bytes; below particle_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not
+/// allocate.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_fixed_flags(
+    world: *const ts_world,
+    body: u32,
+    out: *mut u8,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_array(
+            world,
+            body,
+            out,
+            len,
+            "fixed flags",
+            "bytes",
+            |_, b| b.particle_count(),
+            |_, b, dst| put(dst, (0..b.particle_count()).map(|i| b.is_fixed(i) as u8)),
+        )
+    }
+}
+
+/// Contact radius of the body's particles (m) into *out_radius: a particle touches a tool
+/// when its centre comes closer than this to the tool's surface.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_radius` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_particle_radius(
+    world: *const ts_world,
+    body: u32,
+    out_radius: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_radius, |b| b.particle_radius()) }
+}
+
+/// Set the friction between two bodies where they touch (organ-organ contact; frictionless
+/// unless set): static coefficient `friction_static` (mu_s) and kinetic `friction_kinetic`
+/// (mu_k), dimensionless, 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give
+/// TS_STATUS_NON_FINITE). The pair is unordered; `body_a` may equal `body_b` (self-contact,
+/// see ts_settings.self_contact). Setting a pair again replaces its coefficients. Nothing
+/// changes on error.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_set_body_pair_friction(
+    world: *mut ts_world,
+    body_a: u32,
+    body_b: u32,
+    friction_static: f64,
+    friction_kinetic: f64,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| {
+            w.set_body_pair_friction(
+                BodyId(body_a),
+                BodyId(body_b),
+                friction_static,
+                friction_kinetic,
+            )
+        })
+    })
+}

@@ -1,13 +1,15 @@
-//! Tools: kinematic rigid instruments (sphere, capsule, cylinder, box, OBJ mesh), their poses
+//! Tools: kinematic rigid instruments (sphere, capsule, cylinder, box, convex hull, triangle
+//! mesh from arrays or OBJ), adding and removing them, their poses, friction
 //! and the contact wrench the tissue exerts on them.
 
 use crate::collision::tool::{Pose, ToolOptions, ToolShape};
-use crate::ffi::args::{non_null, world_mut, world_ref, write};
+use crate::ffi::args::{element_count, input_slice, non_null, world_mut, world_ref, write};
 use crate::ffi::body::c_path;
 use crate::ffi::error::FfiResult;
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
+use crate::math::Vec3;
 use crate::mesh;
 use crate::world::ToolId;
 use std::ffi::c_char;
@@ -19,7 +21,8 @@ pub struct ts_pose {
     /// Position of the tool origin (m, world frame), [x, y, z].
     pub position: [f64; 3],
     /// Orientation as a quaternion [w, x, y, z] (local to world); normalised on use, so it
-    /// need not be unit length, but it must not be zero. Identity: {1, 0, 0, 0}.
+    /// need not be unit length, but its norm must be at least 1e-12 (else
+    /// TS_STATUS_INVALID_ARGUMENT). Identity: {1, 0, 0, 0}.
     pub orientation: [f64; 4],
 }
 
@@ -365,6 +368,153 @@ pub unsafe extern "C" fn ts_tool_contact_count(
         let n = h.world.tool(ToolId(tool))?.wrench().contact_count;
         // SAFETY: checked non-NULL.
         unsafe { write(out_count, n) };
+        Ok(())
+    })
+}
+
+/// `count` points given as `count x 3` doubles at `xyz` (the length check of a C array; the
+/// values are checked by the core).
+///
+/// # Safety
+///
+/// `xyz` is NULL or holds `3 * count` readable doubles.
+unsafe fn points(xyz: *const f64, count: usize, name: &str) -> FfiResult<Vec<Vec3>> {
+    let n = element_count::<f64>(count, 3, name)?;
+    // SAFETY: contract of the caller.
+    let xyz = unsafe { input_slice(xyz, n, name)? };
+    Ok(xyz
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+/// Add a convex tool: the convex hull of `point_count` points (`points` holds point_count x 3
+/// doubles, x, y, z per point, m, tool frame). At least 4 points not all in one plane (else
+/// TS_STATUS_INVALID_ARGUMENT); NaN/Inf give TS_STATUS_NON_FINITE. Points inside the hull are
+/// ignored. Otherwise as ts_world_add_tool_sphere. Allocates.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `points` is NULL or holds 3 * point_count readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_convex_hull(
+    world: *mut ts_world,
+    points: *const f64,
+    point_count: usize,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if points.is_null() {
+        return guard(|| non_null(points, "points"));
+    }
+    let shape = || {
+        // SAFETY: non-NULL, 3 * point_count readable doubles by contract.
+        let points = unsafe { self::points(points, point_count, "points")? };
+        Ok(ToolShape::ConvexHull { points })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a triangle-mesh tool from arrays: `vertices` holds vertex_count x 3 doubles (m, tool
+/// frame), `triangles` holds triangle_count x 3 vertex indices (0-based, counter-clockwise seen
+/// from outside). An index >= vertex_count or no triangle gives TS_STATUS_INVALID_ARGUMENT,
+/// NaN/Inf TS_STATUS_NON_FINITE. Otherwise as ts_world_add_tool_sphere. Allocates.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `vertices` is NULL or holds 3 * vertex_count readable doubles;
+/// `triangles` is NULL or holds 3 * triangle_count readable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_mesh(
+    world: *mut ts_world,
+    vertices: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if vertices.is_null() || triangles.is_null() {
+        return guard(|| {
+            non_null(vertices, "vertices")?;
+            non_null(triangles, "triangles")
+        });
+    }
+    let shape = || {
+        // SAFETY: non-NULL, 3 * vertex_count readable doubles by contract.
+        let vertices = unsafe { points(vertices, vertex_count, "vertices")? };
+        let n = element_count::<u32>(triangle_count, 3, "triangle_count")?;
+        // SAFETY: non-NULL, 3 * triangle_count readable uint32_t by contract.
+        let idx = unsafe { input_slice(triangles, n, "triangles")? };
+        Ok(ToolShape::TriMesh {
+            vertices,
+            triangles: idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Remove a tool: from the next ts_world_step on it no longer touches the tissue. Its id is
+/// not reused: every later call with it gives TS_STATUS_UNKNOWN_TOOL, and tools added later get
+/// new ids. A state saved before the removal no longer restores (TS_STATUS_BAD_STATE).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_remove_tool(world: *mut ts_world, tool: u32) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| w.remove_tool(ToolId(tool)))
+    })
+}
+
+/// Set a tool's friction with the tissue, from the next step on: static coefficient
+/// `friction_static` (mu_s) and kinetic `friction_kinetic` (mu_k), dimensionless, with
+/// 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give TS_STATUS_NON_FINITE). The
+/// tool is unchanged on error.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_set_friction(
+    world: *mut ts_world,
+    tool: u32,
+    friction_static: f64,
+    friction_kinetic: f64,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| w.set_tool_friction(ToolId(tool), friction_static, friction_kinetic))
+    })
+}
+
+/// The options a tool has now (friction coefficients, dimensionless; sample spacing in m, 0 when
+/// automatic) into *out_options.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_options` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_get_options(
+    world: *const ts_world,
+    tool: u32,
+    out_options: *mut ts_tool_options,
+) -> ts_status {
+    guard(|| {
+        non_null(out_options, "out_options")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let o = ts_tool_options::from(h.world.tool(ToolId(tool))?.options());
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_options, o) };
         Ok(())
     })
 }
