@@ -299,7 +299,8 @@ typedef struct ts_pose {
     double position[3];
     /**
      * Orientation as a quaternion [w, x, y, z] (local to world); normalised on use, so it
-     * need not be unit length, but it must not be zero. Identity: {1, 0, 0, 0}.
+     * need not be unit length, but its norm must be at least 1e-12 (else
+     * TS_STATUS_INVALID_ARGUMENT). Identity: {1, 0, 0, 0}.
      */
     double orientation[4];
 } ts_pose;
