@@ -98,9 +98,9 @@ pub struct SurfaceMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// Check a load scale factor (mesh units → m): finite ([`Error::NonFinite`](crate::Error)) and
-/// > 0 ([`Error::InvalidArgument`](crate::Error)). The readers apply this rule (reporting a
-/// [`MeshError`] naming the file); the C API checks it before opening a file.
+/// Check a load scale factor (mesh units → m): finite, else [`Error::NonFinite`](crate::Error),
+/// and positive, else [`Error::InvalidArgument`](crate::Error). The readers apply this rule
+/// (reporting a [`MeshError`] naming the file); the C API checks it before opening a file.
 pub fn validate_scale(scale: Real) -> Result<(), crate::Error> {
     crate::error::check_positive("scale", scale, "")
 }
