@@ -126,12 +126,162 @@ static void test_settle(double h) {
     ts_world_free(world);
 }
 
+/* The functions that cover the rest of the Rust API: body state, fixed flags, particle radius,
+ * pair and tool friction, convex-hull and triangle-array tools, removing a tool, and a capsule
+ * of half-height 0 (a sphere). Uses the lattice of build_lattice (edge CELLS * h). */
+static void test_coverage(double h) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    uint32_t body = 99, other = 99;
+    CHECK_OK(ts_settings_default(&settings));
+    settings.gravity[1] = 0; /* only the tool deforms the lattice */
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
+    static double shifted[3 * NN]; /* the lattice 0.2 m further along z */
+    for (int i = 0; i < 3 * NN; i++) shifted[i] = nodes[i] + (i % 3 == 2 ? 0.2 : 0.0);
+    CHECK_OK(
+        ts_world_add_body_from_arrays(world, shifted, NN, tets, NT, &material, NULL, &other));
+    double lo[3] = {OX - 1, -1e-9, -1}, hi[3] = {OX + 1, 1e-9, 1};
+    size_t fixed = 0;
+    CHECK_OK(ts_body_fix_box(world, body, lo, hi, &fixed));
+    CHECK(fixed == (CELLS + 1) * (CELLS + 1));
+
+    /* Fixed flags: 1 on the bottom face, 0 elsewhere. */
+    uint8_t flags[NN];
+    memset(flags, 7, sizeof flags);
+    CHECK_OK(ts_body_fixed_flags(world, body, flags, NN));
+    size_t ones = 0;
+    int flags_right = 1;
+    for (int i = 0; i < NN; i++) {
+        ones += flags[i] == 1;
+        flags_right &= flags[i] == (nodes[3 * i + 1] == 0 ? 1 : 0);
+    }
+    CHECK(ones == fixed && flags_right);
+    CHECK_ST(ts_body_fixed_flags(world, body, flags, NN - 1), TS_STATUS_BUFFER_TOO_SMALL);
+    CHECK_ST(ts_body_fixed_flags(world, 9, flags, NN), TS_STATUS_UNKNOWN_BODY);
+    double radius = 0;
+    CHECK_OK(ts_body_particle_radius(world, body, &radius));
+    CHECK(radius > 0 && radius < h);
+    CHECK_ST(ts_body_particle_radius(world, body, NULL), TS_STATUS_NULL_PARAMETER);
+
+    /* Set positions and velocities, read them back; fixed particles get zero velocity. */
+    static double x[3 * NN], v[3 * NN], got[3 * NN];
+    for (int i = 0; i < 3 * NN; i++) {
+        x[i] = nodes[i] + 1e-4 * (i % 3);
+        v[i] = (i % 3 == 2) ? 0.05 : 0.0;
+    }
+    CHECK_OK(ts_body_set_state(world, body, x, 3 * NN, v, 3 * NN));
+    CHECK_OK(ts_body_positions(world, body, got, 3 * NN));
+    CHECK(memcmp(got, x, sizeof x) == 0);
+    CHECK_OK(ts_body_velocities(world, body, got, 3 * NN));
+    int v_right = 1;
+    for (int i = 0; i < NN; i++) v_right &= got[3 * i + 2] == (flags[i] ? 0.0 : 0.05);
+    CHECK(v_right);
+    CHECK_ST(ts_body_set_state(world, body, x, 3 * NN - 1, v, 3 * NN), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_body_set_state(world, body, x, 3 * NN, v, 3 * NN - 3), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_body_set_state(world, body, x, 3 * NN, NULL, 3 * NN), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_body_set_state(world, 9, x, 3 * NN, v, 3 * NN), TS_STATUS_UNKNOWN_BODY);
+    v[4] = NAN;
+    CHECK_ST(ts_body_set_state(world, body, x, 3 * NN, v, 3 * NN), TS_STATUS_NON_FINITE);
+    CHECK_OK(ts_body_positions(world, body, got, 3 * NN));
+    CHECK(memcmp(got, x, sizeof x) == 0); /* unchanged by the failed calls */
+
+    /* Body-pair friction. */
+    CHECK_OK(ts_world_set_body_pair_friction(world, body, other, 0.5, 0.4));
+    CHECK_OK(ts_world_set_body_pair_friction(world, other, other, 0.2, 0.2));
+    CHECK_ST(ts_world_set_body_pair_friction(world, body, 9, 0.5, 0.4), TS_STATUS_UNKNOWN_BODY);
+    CHECK_ST(ts_world_set_body_pair_friction(world, body, other, 0.3, 0.4),
+             TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_world_set_body_pair_friction(world, body, other, NAN, 0.4), TS_STATUS_NON_FINITE);
+    CHECK_ST(ts_world_set_body_pair_friction(NULL, body, other, 0.5, 0.4),
+             TS_STATUS_NULL_PARAMETER);
+
+    /* Tools: a convex hull (a tetrahedron), a triangle mesh from arrays, a capsule of
+     * half-height 0; friction; removal. */
+    ts_pose far = {{2, 2, 2}, {1, 0, 0, 0}};
+    const double tetra[12] = {0, 0, 0, 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01};
+    const double flat[12] = {0, 0, 0, 0.01, 0, 0, 0, 0.01, 0, 0.01, 0.01, 0};
+    const uint32_t tri[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    uint32_t hull = 99, trimesh = 99, ball = 99, id = 66;
+    CHECK_OK(ts_world_add_tool_convex_hull(world, tetra, 4, &far, NULL, &hull));
+    CHECK(hull == 0);
+    CHECK_ST(ts_world_add_tool_convex_hull(world, flat, 4, &far, NULL, &id),
+             TS_STATUS_INVALID_ARGUMENT);
+    CHECK(last_error_has("plane"));
+    CHECK_ST(ts_world_add_tool_convex_hull(world, tetra, 3, &far, NULL, &id),
+             TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_world_add_tool_convex_hull(world, NULL, 4, &far, NULL, &id),
+             TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_world_add_tool_mesh(world, tetra, 4, tri, 4, &far, NULL, &trimesh));
+    CHECK(trimesh == 1);
+    CHECK_ST(ts_world_add_tool_mesh(world, tetra, 3, tri, 4, &far, NULL, &id),
+             TS_STATUS_INVALID_ARGUMENT);
+    CHECK(id == 66);
+    ts_pose above = {{OX + CELLS * h / 2, CELLS * h + 0.011, CELLS * h / 2}, {1, 0, 0, 0}};
+    CHECK_OK(ts_world_add_tool_capsule(world, 0.0, 0.01, &above, NULL, &ball));
+    CHECK(ball == 2);
+    CHECK_ST(ts_world_add_tool_capsule(world, -0.001, 0.01, &far, NULL, &id),
+             TS_STATUS_INVALID_ARGUMENT);
+    ts_tool_options opts;
+    CHECK_OK(ts_tool_set_friction(world, ball, 0.6, 0.5));
+    CHECK_OK(ts_tool_get_options(world, ball, &opts));
+    CHECK(opts.friction_static == 0.6 && opts.friction_kinetic == 0.5 && opts.sample_spacing == 0);
+    CHECK_ST(ts_tool_set_friction(world, ball, 0.4, 0.5), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_tool_set_friction(world, ball, INFINITY, 0.5), TS_STATUS_NON_FINITE);
+    CHECK_ST(ts_tool_set_friction(world, 9, 0.6, 0.5), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_tool_get_options(world, ball, NULL), TS_STATUS_NULL_PARAMETER);
+
+    /* The capsule presses the top face 2.5 mm (0.1 m/s), then is removed: its id goes stale,
+     * the next tool gets a new id, and it no longer pushes. */
+    static const double rest_v[3 * NN];
+    CHECK_OK(ts_body_set_state(world, body, nodes, 3 * NN, rest_v, 3 * NN)); /* back to rest */
+    for (int s = 1; s <= 30; s++) {
+        ts_pose p = above;
+        p.position[1] = CELLS * h + 0.01 + 0.0005 - 1e-4 * s;
+        CHECK_OK(ts_tool_set_pose(world, ball, &p));
+        CHECK_OK(ts_world_step(world, NULL));
+    }
+    ts_wrench w;
+    CHECK_OK(ts_tool_wrench(world, ball, &w));
+    CHECK(w.contact_count > 0 && w.force[1] > 0);
+    uint32_t count = 0;
+    CHECK_OK(ts_world_tool_count(world, &count));
+    CHECK(count == 3);
+    CHECK_OK(ts_world_remove_tool(world, ball));
+    CHECK_ST(ts_world_remove_tool(world, ball), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_tool_wrench(world, ball, &w), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_tool_set_pose(world, ball, &above), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_world_remove_tool(NULL, 0), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_world_tool_count(world, &count));
+    CHECK(count == 2);
+    CHECK_OK(ts_world_add_tool_sphere(world, 0.01, &far, NULL, &id));
+    CHECK(id == 3);
+    /* The dent (lowest top-face particle below the top face) springs back. */
+    double dent_pressed = 0, dent_free = 0;
+    CHECK_OK(ts_body_positions(world, body, got, 3 * NN));
+    for (int i = 0; i <= CELLS; i++)
+        for (int k = 0; k <= CELLS; k++)
+            dent_pressed = fmax(dent_pressed, CELLS * h - got[3 * node_id(i, CELLS, k) + 1]);
+    for (int s = 0; s < 300; s++) CHECK_OK(ts_world_step(world, NULL));
+    CHECK_OK(ts_body_positions(world, body, got, 3 * NN));
+    for (int i = 0; i <= CELLS; i++)
+        for (int k = 0; k <= CELLS; k++)
+            dent_free = fmax(dent_free, CELLS * h - got[3 * node_id(i, CELLS, k) + 1]);
+    printf("dent %.3g mm pressed, %.3g mm 0.3 s after the tool was removed\n", 1e3 * dent_pressed,
+           1e3 * dent_free);
+    CHECK(dent_pressed > 5e-4 && dent_free < 0.75 * dent_pressed);
+    ts_world_free(world);
+}
+
 int main(void) {
     long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
     if (steps < 2) steps = 2;
     const double h = 0.02; /* 6 cm cube */
     build_lattice(h);
     test_settle(h);
+    test_coverage(h);
 
     /* ---- version, status strings, last error ---- */
     CHECK(ts_version() == TISSUESIM_VERSION);

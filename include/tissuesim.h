@@ -323,7 +323,8 @@ typedef struct ts_pose {
     double position[3];
     /**
      * Orientation as a quaternion [w, x, y, z] (local to world); normalised on use, so it
-     * need not be unit length, but it must not be zero. Identity: {1, 0, 0, 0}.
+     * need not be unit length, but its norm must be at least 1e-12 (else
+     * TS_STATUS_INVALID_ARGUMENT). Identity: {1, 0, 0, 0}.
      */
     double orientation[4];
 } ts_pose;
@@ -403,8 +404,9 @@ void ts_last_error_clear(void);
 enum ts_status ts_settings_default(struct ts_settings *out);
 
 /**
- * Create an empty world with `settings` (validated: NaN/Inf give TS_STATUS_NON_FINITE, out of
- * range values TS_STATUS_INVALID_ARGUMENT) and store its handle in *out_world. Release it with
+ * Create an empty world with `settings` (validated by the core: NaN/Inf give
+ * TS_STATUS_NON_FINITE, out of range values TS_STATUS_INVALID_ARGUMENT, the message names the
+ * field) and store its handle in *out_world. Release it with
  * ts_world_free.
  *
  * # Safety
@@ -487,7 +489,8 @@ enum ts_status ts_world_time(const struct ts_world *world, double *out_time);
 enum ts_status ts_world_body_count(const struct ts_world *world, uint32_t *out_count);
 
 /**
- * Number of tools in the world (their ids are 0 .. count-1).
+ * Number of tools in the world, removed tools not counted (tool ids are 0, 1, 2, ... in
+ * order of creation and never reused, so after ts_world_remove_tool they are not 0 .. count-1).
  *
  * # Safety
  *
@@ -766,6 +769,70 @@ enum ts_status ts_body_added_mass(const struct ts_world *world, uint32_t body, d
 enum ts_status ts_body_mass(const struct ts_world *world, uint32_t body, double *out_mass);
 
 /**
+ * Set the positions and velocities of every particle of a body, e.g. an initial condition or
+ * a reset: `positions` holds particle_count x 3 doubles (m, world frame), `velocities`
+ * particle_count x 3 doubles (m/s); `positions_len` and `velocities_len` are their lengths in
+ * doubles and must both be 3 * particle_count (else TS_STATUS_INVALID_ARGUMENT). NaN/Inf give
+ * TS_STATUS_NON_FINITE. Fixed particles take the given position and zero velocity (and stay
+ * fixed there). Nothing changes on error. Allocates (not for every haptic frame).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `positions` is NULL or holds `positions_len` readable
+ * doubles; `velocities` is NULL or holds `velocities_len` readable doubles.
+ */
+enum ts_status ts_body_set_state(struct ts_world *world,
+                                 uint32_t body,
+                                 const double *positions,
+                                 size_t positions_len,
+                                 const double *velocities,
+                                 size_t velocities_len);
+
+/**
+ * Whether each particle is fixed (1) or free (0) into `out`: particle_count bytes. `len` in
+ * bytes; below particle_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not
+ * allocate.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out` is NULL or holds `len` writable bytes.
+ */
+enum ts_status ts_body_fixed_flags(const struct ts_world *world,
+                                   uint32_t body,
+                                   uint8_t *out,
+                                   size_t len);
+
+/**
+ * Contact radius of the body's particles (m) into *out_radius: a particle touches a tool
+ * when its centre comes closer than this to the tool's surface.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_radius` is NULL or writable.
+ */
+enum ts_status ts_body_particle_radius(const struct ts_world *world,
+                                       uint32_t body,
+                                       double *out_radius);
+
+/**
+ * Set the friction between two bodies where they touch (organ-organ contact; frictionless
+ * unless set): static coefficient `friction_static` (mu_s) and kinetic `friction_kinetic`
+ * (mu_k), dimensionless, 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give
+ * TS_STATUS_NON_FINITE). The pair is unordered; `body_a` may equal `body_b` (self-contact,
+ * see ts_settings.self_contact). Setting a pair again replaces its coefficients. Nothing
+ * changes on error.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_set_body_pair_friction(struct ts_world *world,
+                                               uint32_t body_a,
+                                               uint32_t body_b,
+                                               double friction_static,
+                                               double friction_kinetic);
+
+/**
  * Write the default tool options (no friction, automatic sample spacing) into *out.
  *
  * # Safety
@@ -790,8 +857,9 @@ enum ts_status ts_world_add_tool_sphere(struct ts_world *world,
                                         uint32_t *out_tool);
 
 /**
- * Add a capsule tool along its local y axis: `half_height` (m, >= 0) is half the distance
- * between the hemisphere centres, `radius` (m, > 0). Otherwise as ts_world_add_tool_sphere.
+ * Add a capsule tool along its local y axis: `half_height` (m, >= 0; 0 gives a sphere) is half
+ * the distance between the hemisphere centres, `radius` (m, > 0). Otherwise as
+ * ts_world_add_tool_sphere.
  *
  * # Safety
  *
@@ -894,6 +962,81 @@ enum ts_status ts_tool_wrench(const struct ts_world *world,
 enum ts_status ts_tool_contact_count(const struct ts_world *world,
                                      uint32_t tool,
                                      uint32_t *out_count);
+
+/**
+ * Add a convex tool: the convex hull of `point_count` points (`points` holds point_count x 3
+ * doubles, x, y, z per point, m, tool frame). At least 4 points not all in one plane (else
+ * TS_STATUS_INVALID_ARGUMENT); NaN/Inf give TS_STATUS_NON_FINITE. Points inside the hull are
+ * ignored. Otherwise as ts_world_add_tool_sphere. Allocates.
+ *
+ * # Safety
+ *
+ * As ts_world_add_tool_sphere; `points` is NULL or holds 3 * point_count readable doubles.
+ */
+enum ts_status ts_world_add_tool_convex_hull(struct ts_world *world,
+                                             const double *points,
+                                             size_t point_count,
+                                             const struct ts_pose *pose,
+                                             const struct ts_tool_options *options,
+                                             uint32_t *out_tool);
+
+/**
+ * Add a triangle-mesh tool from arrays: `vertices` holds vertex_count x 3 doubles (m, tool
+ * frame), `triangles` holds triangle_count x 3 vertex indices (0-based, counter-clockwise seen
+ * from outside). An index >= vertex_count or no triangle gives TS_STATUS_INVALID_ARGUMENT,
+ * NaN/Inf TS_STATUS_NON_FINITE. Otherwise as ts_world_add_tool_sphere. Allocates.
+ *
+ * # Safety
+ *
+ * As ts_world_add_tool_sphere; `vertices` is NULL or holds 3 * vertex_count readable doubles;
+ * `triangles` is NULL or holds 3 * triangle_count readable uint32_t.
+ */
+enum ts_status ts_world_add_tool_mesh(struct ts_world *world,
+                                      const double *vertices,
+                                      size_t vertex_count,
+                                      const uint32_t *triangles,
+                                      size_t triangle_count,
+                                      const struct ts_pose *pose,
+                                      const struct ts_tool_options *options,
+                                      uint32_t *out_tool);
+
+/**
+ * Remove a tool: from the next ts_world_step on it no longer touches the tissue. Its id is
+ * not reused: every later call with it gives TS_STATUS_UNKNOWN_TOOL, and tools added later get
+ * new ids. A state saved before the removal no longer restores (TS_STATUS_BAD_STATE).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_remove_tool(struct ts_world *world, uint32_t tool);
+
+/**
+ * Set a tool's friction with the tissue, from the next step on: static coefficient
+ * `friction_static` (mu_s) and kinetic `friction_kinetic` (mu_k), dimensionless, with
+ * 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give TS_STATUS_NON_FINITE). The
+ * tool is unchanged on error.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_tool_set_friction(struct ts_world *world,
+                                    uint32_t tool,
+                                    double friction_static,
+                                    double friction_kinetic);
+
+/**
+ * The options a tool has now (friction coefficients, dimensionless; sample spacing in m, 0 when
+ * automatic) into *out_options.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_options` is NULL or writable.
+ */
+enum ts_status ts_tool_get_options(const struct ts_world *world,
+                                   uint32_t tool,
+                                   struct ts_tool_options *out_options);
 
 /**
  * Size in bytes of the state ts_world_save_state writes for the world as it is now (it

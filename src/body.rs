@@ -3,7 +3,7 @@
 
 use crate::consistency;
 use crate::elastic::{self, ElasticModel, ForceInputs};
-use crate::error::Error;
+use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
@@ -43,22 +43,27 @@ pub const YOUNGS_MODULUS_RANGE: (Real, Real) = (1e-6, 1e12);
 pub const DENSITY_RANGE: (Real, Real) = (1e-6, 1e5);
 
 impl Material {
-    /// Check the material: E in [`YOUNGS_MODULUS_RANGE`], ν in [[`MIN_POISSON_RATIO`],
-    /// [`MAX_POISSON_RATIO`]], ρ in [`DENSITY_RANGE`]. The message names the field, the range
-    /// and why.
+    /// Check the material: NaN or ±Inf give [`Error::NonFinite`]; E outside
+    /// [`YOUNGS_MODULUS_RANGE`], ν outside [[`MIN_POISSON_RATIO`], [`MAX_POISSON_RATIO`]] or ρ
+    /// outside [`DENSITY_RANGE`] give [`Error::InvalidArgument`], the message naming the field,
+    /// the range and why. The one validation of materials, used when a body is built, by the C
+    /// API and by the FMU.
     pub fn validate(&self) -> Result<(), Error> {
+        check_finite("material.youngs_modulus", self.youngs_modulus)?;
+        check_finite("material.poisson_ratio", self.poisson_ratio)?;
+        check_finite("material.density", self.density)?;
         let bad = |s: String| Err(Error::InvalidArgument(s));
         let (e_lo, e_hi) = YOUNGS_MODULUS_RANGE;
         if !(e_lo..=e_hi).contains(&self.youngs_modulus) {
             return bad(format!(
-                "Young's modulus must be in [{e_lo:e}, {e_hi:e}] Pa, got {:e}",
+                "material.youngs_modulus must be in [{e_lo:e}, {e_hi:e}] Pa, got {:e}",
                 self.youngs_modulus
             ));
         }
         let nu = self.poisson_ratio;
-        if !(nu.is_finite() && (MIN_POISSON_RATIO..=MAX_POISSON_RATIO).contains(&nu)) {
+        if !(MIN_POISSON_RATIO..=MAX_POISSON_RATIO).contains(&nu) {
             return bad(format!(
-                "Poisson ratio must be in [{MIN_POISSON_RATIO}, {MAX_POISSON_RATIO}], got {nu}: \
+                "material.poisson_ratio must be in [{MIN_POISSON_RATIO}, {MAX_POISSON_RATIO}], got {nu}: \
                  negative values are auxetic (not tissue) and unstable here, and the volumetric \
                  stiffness lambda = E nu / ((1 + nu)(1 - 2 nu)) diverges as nu -> 0.5"
             ));
@@ -66,7 +71,7 @@ impl Material {
         let (d_lo, d_hi) = DENSITY_RANGE;
         if !(d_lo..=d_hi).contains(&self.density) {
             return bad(format!(
-                "density must be in [{d_lo:e}, {d_hi:e}] kg/m3, got {:e}",
+                "material.density must be in [{d_lo:e}, {d_hi:e}] kg/m3, got {:e}",
                 self.density
             ));
         }
@@ -143,11 +148,30 @@ pub const PARTICLE_RADIUS_RANGE: (Real, Real) = (0.05, 2.0);
 pub const SUPPORT_RADIUS_RANGE: (Real, Real) = (0.5, 3.0);
 
 impl BodyOptions {
+    /// Check the options: the material ([`Material::validate`]), radii finite and > 0 m when
+    /// given, `target_neighbours` ≥ 1. NaN or ±Inf give [`Error::NonFinite`], other bad values
+    /// [`Error::InvalidArgument`]. Used when a body is built and by the C API.
+    pub fn validate(&self) -> Result<(), Error> {
+        self.material.validate()?;
+        if let Some(r) = self.support_radius {
+            check_positive("options.support_radius", r, "m")?;
+        }
+        if let Some(r) = self.particle_radius {
+            check_positive("options.particle_radius", r, "m")?;
+        }
+        if self.target_neighbours == 0 {
+            return Err(Error::InvalidArgument(
+                "options.target_neighbours must be >= 1".into(),
+            ));
+        }
+        Ok(())
+    }
+
     /// Check the material and the radii against a mesh of mean edge length `mean_edge` (m):
     /// explicit radii must lie in [`PARTICLE_RADIUS_RANGE`] and [`SUPPORT_RADIUS_RANGE`] (in
     /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](neighbours::MAX_NEIGHBOURS).
     pub fn check_radii(&self, mean_edge: Real) -> Result<(), Error> {
-        self.material.validate()?;
+        self.validate()?;
         for (name, value, (lo, hi)) in [
             (
                 "particle_radius",
@@ -259,9 +283,9 @@ impl Body {
         options: &BodyOptions,
         settings: &Settings,
     ) -> Result<Body, Error> {
+        options.validate()?;
         let m = &options.material;
         let bad = |s: String| Err(Error::InvalidArgument(s));
-        m.validate()?;
         let n = mesh.nodes.len();
         if mesh.tets.is_empty() || n < 5 {
             return bad("a body needs at least one tetrahedron and 5 nodes".into());

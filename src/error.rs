@@ -54,3 +54,38 @@ impl From<MeshError> for Error {
         Error::Mesh(e)
     }
 }
+
+/// `value` is finite: NaN or ±Inf give [`Error::NonFinite`] naming `what`.
+pub(crate) fn check_finite(what: &str, value: f64) -> Result<(), Error> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::NonFinite(format!("{what} is {value}")))
+    }
+}
+
+/// `value` is finite ([`Error::NonFinite`] otherwise) and > 0 ([`Error::InvalidArgument`]
+/// otherwise); `what` names it and `unit` is its unit in the message.
+pub(crate) fn check_positive(what: &str, value: f64, unit: &str) -> Result<(), Error> {
+    check_finite(what, value)?;
+    if value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{what} must be > 0 {unit}, got {value}"
+        )))
+    }
+}
+
+/// `value` is finite ([`Error::NonFinite`] otherwise) and >= 0 ([`Error::InvalidArgument`]
+/// otherwise); `what` names it and `unit` is its unit in the message.
+pub(crate) fn check_non_negative(what: &str, value: f64, unit: &str) -> Result<(), Error> {
+    check_finite(what, value)?;
+    if value >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{what} must be >= 0 {unit}, got {value}"
+        )))
+    }
+}

@@ -153,37 +153,48 @@ impl Default for Settings {
 }
 
 impl Settings {
-    /// Check every field is finite and in range; the message names the first one that is not.
+    /// Check every field: NaN or ±Inf give [`Error::NonFinite`](crate::Error::NonFinite),
+    /// out-of-range values [`Error::InvalidArgument`](crate::Error::InvalidArgument); the
+    /// message names the first bad field (`settings.<field>`). The one validation of settings,
+    /// used by [`World::new`](crate::World::new), [`World::set_settings`](crate::World::set_settings)
+    /// and the C API.
     pub fn validate(&self) -> Result<(), crate::Error> {
+        use crate::error::{check_finite, check_non_negative, check_positive};
         use crate::Error;
-        let bad = |m: &str| Err(Error::InvalidArgument(m.to_string()));
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad("dt must be finite and > 0 s");
+        let bad = |m: &str| Err(Error::InvalidArgument(format!("settings.{m}")));
+        for (name, v) in [
+            ("settings.dt", self.dt),
+            ("settings.gravity[0]", self.gravity.x),
+            ("settings.gravity[1]", self.gravity.y),
+            ("settings.gravity[2]", self.gravity.z),
+            ("settings.stability_margin", self.stability_margin),
+            ("settings.damping_mass", self.damping_mass),
+            ("settings.damping_stiffness", self.damping_stiffness),
+            ("settings.hourglass_stiffness", self.hourglass_stiffness),
+            ("settings.volume_compliance", self.volume_compliance),
+            (
+                "settings.max_depenetration_speed",
+                self.max_depenetration_speed,
+            ),
+        ] {
+            check_finite(name, v)?;
         }
-        if !crate::math::is_finite_vec(&self.gravity) {
-            return Err(Error::NonFinite("gravity".into()));
-        }
+        check_positive("settings.dt", self.dt, "s")?;
         if self.min_substeps == 0 || self.max_substeps < self.min_substeps {
-            return bad("substeps: need 1 <= min_substeps <= max_substeps");
+            return bad("min_substeps/max_substeps: need 1 <= min_substeps <= max_substeps");
         }
         if !(self.stability_margin > 0.0 && self.stability_margin <= 1.0) {
             return bad("stability_margin must be in (0, 1]");
         }
-        for (name, v) in [
-            ("damping_mass", self.damping_mass),
-            ("damping_stiffness", self.damping_stiffness),
-            ("hourglass_stiffness", self.hourglass_stiffness),
-            ("volume_compliance", self.volume_compliance),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::InvalidArgument(format!(
-                    "{name} must be finite and >= 0"
-                )));
-            }
-        }
-        if !(self.max_depenetration_speed.is_finite() && self.max_depenetration_speed > 0.0) {
-            return bad("max_depenetration_speed must be finite and > 0 m/s");
-        }
+        check_non_negative("settings.damping_mass", self.damping_mass, "1/s")?;
+        check_non_negative("settings.damping_stiffness", self.damping_stiffness, "s")?;
+        check_non_negative("settings.hourglass_stiffness", self.hourglass_stiffness, "")?;
+        check_non_negative("settings.volume_compliance", self.volume_compliance, "1/Pa")?;
+        check_positive(
+            "settings.max_depenetration_speed",
+            self.max_depenetration_speed,
+            "m/s",
+        )?;
         if !(1..=64).contains(&self.threads) {
             return bad("threads must be in 1..=64");
         }

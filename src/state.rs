@@ -9,7 +9,7 @@
 //! | body count, tool count | u32, u32 |
 //! | time (s) | f64 |
 //! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
-//! | per tool: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
+//! | per tool in the world (removed tools left out), in id order: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
 //! | FNV-1a 64 checksum of everything before it | u64 |
 //!
 //! The scene itself (meshes, materials, fixed particles, settings) is not part of the state: a
@@ -104,7 +104,7 @@ impl World {
         HEADER
             + self.bodies.len() * 4
             + particles * 10 * 8
-            + self.tools.len() * (TOOL_REALS * 8 + 4)
+            + self.tool_count() * (TOOL_REALS * 8 + 4)
             + 8
     }
 
@@ -117,7 +117,7 @@ impl World {
         w.0.extend_from_slice(MAGIC);
         w.u32(STATE_VERSION);
         w.u32(self.bodies.len() as u32);
-        w.u32(self.tools.len() as u32);
+        w.u32(self.tool_count() as u32);
         w.f64(self.time);
         for b in &self.bodies {
             w.u32(b.particle_count() as u32);
@@ -125,7 +125,7 @@ impl World {
             b.v.iter().for_each(|v| w.vec3(v));
             b.rotation.iter().for_each(|q| w.quat(q));
         }
-        for t in &self.tools {
+        for t in self.tools.iter().flatten() {
             w.pose(&t.pose);
             w.pose(&t.target);
             w.vec3(&t.linear_velocity);
@@ -156,7 +156,7 @@ impl World {
                 "state format version {version}, this library reads {STATE_VERSION}"
             )));
         }
-        if r.u32() as usize != self.bodies.len() || r.u32() as usize != self.tools.len() {
+        if r.u32() as usize != self.bodies.len() || r.u32() as usize != self.tool_count() {
             return bad("body or tool count differs from this world");
         }
         if bytes.len() != self.state_size() {
@@ -206,7 +206,7 @@ impl World {
                 return bad("non-finite particle rotation");
             }
         }
-        for _ in &self.tools {
+        for _ in self.tools.iter().flatten() {
             let head_finite = (0..TOOL_REALS - 1).all(|_| scan.f64().is_finite());
             scan.at += 4;
             if !head_finite || !scan.f64().is_finite() {
@@ -222,7 +222,7 @@ impl World {
             b.v.iter_mut().for_each(|v| *v = r.vec3());
             b.rotation.iter_mut().for_each(|q| *q = r.quat());
         }
-        for t in &mut self.tools {
+        for t in self.tools.iter_mut().flatten() {
             t.pose = r.pose();
             t.target = r.pose();
             t.linear_velocity = r.vec3();

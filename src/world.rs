@@ -58,7 +58,8 @@ struct PairFriction {
 pub struct World {
     pub(crate) settings: Settings,
     pub(crate) bodies: Vec<Body>,
-    pub(crate) tools: Vec<Tool>,
+    /// Tools by id; `None` for a removed tool (ids are never reused).
+    pub(crate) tools: Vec<Option<Tool>>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
     pool: Pool,
@@ -192,11 +193,17 @@ impl World {
         }
         Ok(())
     }
-    /// Fix every particle whose current position lies in the box `[min, max]` (m); returns how
-    /// many particles the box holds.
+    /// Fix every particle whose current position lies in the box `[min, max]` (m, world
+    /// frame, `min <= max` on every axis); returns how many particles the box holds. Nothing
+    /// is fixed on error.
     pub fn fix_box(&mut self, id: BodyId, min: Vec3, max: Vec3) -> Result<usize, Error> {
         if !is_finite_vec(&min) || !is_finite_vec(&max) {
-            return Err(Error::NonFinite("fixed box".into()));
+            return Err(Error::NonFinite("fixed box min/max".into()));
+        }
+        if (0..3).any(|k| min[k] > max[k]) {
+            return Err(Error::InvalidArgument(
+                "fixed box: min must be <= max on every axis".into(),
+            ));
         }
         let body = self.body_mut(id)?;
         let inside: Vec<usize> = (0..body.particle_count())
@@ -223,17 +230,43 @@ impl World {
             .first()
             .map(|b| b.particle_radius())
             .unwrap_or(0.005);
-        self.tools.push(Tool::new(shape, pose, options, spacing)?);
-        Ok(ToolId(self.tools.len() as u32 - 1))
+        let id = u32::try_from(self.tools.len())
+            .map_err(|_| Error::InvalidArgument("no tool id left".into()))?;
+        self.tools
+            .push(Some(Tool::new(shape, pose, options, spacing)?));
+        Ok(ToolId(id))
     }
-    /// Number of tools.
+    /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
+    /// unused (later tools get new ids; calls with the removed id give
+    /// [`Error::UnknownTool`]). Nothing changes on error.
+    pub fn remove_tool(&mut self, id: ToolId) -> Result<(), Error> {
+        self.tool(id)?;
+        self.tools[id.0 as usize] = None;
+        Ok(())
+    }
+    /// Number of tools in the world (removed tools not counted).
     pub fn tool_count(&self) -> usize {
-        self.tools.len()
+        self.tools.iter().flatten().count()
     }
-    /// A tool by id.
+    /// The ids of the tools in the world, in increasing order (removed tools left out).
+    pub fn tool_ids(&self) -> impl Iterator<Item = ToolId> + '_ {
+        self.tools
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.is_some())
+            .map(|(i, _)| ToolId(i as u32))
+    }
+    /// A tool by id ([`Error::UnknownTool`] for an id never issued or removed).
     pub fn tool(&self, id: ToolId) -> Result<&Tool, Error> {
         self.tools
             .get(id.0 as usize)
+            .and_then(Option::as_ref)
+            .ok_or(Error::UnknownTool(id.0))
+    }
+    fn tool_mut(&mut self, id: ToolId) -> Result<&mut Tool, Error> {
+        self.tools
+            .get_mut(id.0 as usize)
+            .and_then(Option::as_mut)
             .ok_or(Error::UnknownTool(id.0))
     }
     /// Set the pose a tool reaches at the end of the next step (interpolated across substeps).
@@ -244,14 +277,11 @@ impl World {
                 "tool pose must be finite with a unit quaternion".into(),
             ));
         }
-        let tool = self
-            .tools
-            .get_mut(id.0 as usize)
-            .ok_or(Error::UnknownTool(id.0))?;
-        tool.target = pose;
+        self.tool_mut(id)?.target = pose;
         Ok(())
     }
-    /// Friction coefficients (μ_s, μ_k) of a tool.
+    /// Set the friction coefficients of a tool: static μ_s and kinetic μ_k (dimensionless,
+    /// finite, 0 ≤ μ_k ≤ μ_s), from the next step on. Nothing changes on error.
     pub fn set_tool_friction(
         &mut self,
         id: ToolId,
@@ -259,16 +289,14 @@ impl World {
         friction_kinetic: Real,
     ) -> Result<(), Error> {
         check_friction(friction_static, friction_kinetic)?;
-        let tool = self
-            .tools
-            .get_mut(id.0 as usize)
-            .ok_or(Error::UnknownTool(id.0))?;
+        let tool = self.tool_mut(id)?;
         tool.options.friction_static = friction_static;
         tool.options.friction_kinetic = friction_kinetic;
         Ok(())
     }
-    /// Friction coefficients (μ_s, μ_k) between two bodies (organ–organ contact; frictionless
-    /// unless set).
+    /// Set the friction coefficients between two bodies (organ–organ contact; frictionless
+    /// unless set): static μ_s and kinetic μ_k (dimensionless, finite, 0 ≤ μ_k ≤ μ_s). `a`
+    /// may equal `b` (self-contact friction). Nothing changes on error.
     pub fn set_body_pair_friction(
         &mut self,
         a: BodyId,
@@ -308,7 +336,7 @@ impl World {
         }
         let stable = (s.dt / (s.stability_margin * h_max)).ceil();
         let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
-        for t in &self.tools {
+        for t in self.tools.iter().flatten() {
             let travel = (t.target.position - t.pose.position).norm()
                 + t.pose.orientation.angle_to(&t.target.orientation) * t.bounding_radius;
             let sweep = (travel / radius).ceil();
@@ -414,7 +442,7 @@ impl World {
             b.saved_rotation.copy_from_slice(&b.rotation);
         }
         let h = self.settings.dt / n as Real;
-        for t in &mut self.tools {
+        for t in self.tools.iter_mut().flatten() {
             t.acc_impulse = Vec3::zeros();
             t.acc_moment = Vec3::zeros();
             t.acc_penetration = 0.0;
@@ -441,7 +469,7 @@ impl World {
             )));
         }
         let dt = self.settings.dt;
-        for t in &mut self.tools {
+        for t in self.tools.iter_mut().flatten() {
             let scale = -1.0 / (h * h * n as Real);
             t.wrench = Wrench {
                 force: t.acc_impulse * scale,
@@ -478,7 +506,7 @@ impl World {
             self.grid
                 .build(self.bodies.iter().map(|b| b.p.as_slice()), cell);
         }
-        for t in &mut self.tools {
+        for t in self.tools.iter_mut().flatten() {
             t.acc_contacts = 0;
         }
         let s_prev = (k - 1) as Real / n as Real;
@@ -494,7 +522,7 @@ impl World {
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;
-            for tool in &mut self.tools {
+            for tool in self.tools.iter_mut().flatten() {
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 for body in &mut self.bodies {

@@ -74,7 +74,7 @@ fn poisson_ratios_outside_the_supported_range_are_refused() {
             },
             ..BodyOptions::default()
         };
-        invalid(w.add_body(&cube(), &options), "Poisson ratio");
+        invalid(w.add_body(&cube(), &options), "poisson_ratio");
     }
     for nu in [0.0, 0.3, 0.45, 0.49] {
         let m = Material {
@@ -145,7 +145,7 @@ fn tool_sample_counts_are_bounded() {
             half_extents: Vec3::repeat(1e300),
         };
         let too_big = w.add_tool(absurd, Pose::at(Vec3::zeros()), &ToolOptions::default());
-        invalid(too_big.map(|_| ()), "half extent");
+        invalid(too_big.map(|_| ()), "half_extents");
         // 200 m across: a legal size, but ~10^9 samples at the default spacing.
         let huge = ToolShape::Cuboid {
             half_extents: Vec3::repeat(100.0),

@@ -1,6 +1,6 @@
 //! Kinematic rigid instruments: their shape (a parry shape), pose, friction and contact wrench.
 
-use crate::error::Error;
+use crate::error::{check_finite, Error};
 use crate::math::{is_finite_vec, Quat, Real, Vec3};
 use parry3d_f64::math::{Isometry, Point, Translation};
 use parry3d_f64::shape::{SharedShape, TriMeshFlags};
@@ -46,6 +46,123 @@ pub enum ToolShape {
     },
 }
 
+/// Points closer than this fraction of the point cloud's extent to a common plane are coplanar
+/// for [`ToolShape::ConvexHull`] (dimensionless).
+pub const CONVEX_HULL_FLATNESS: Real = 1e-9;
+
+impl ToolShape {
+    /// Check the shape: NaN or ±Inf give [`Error::NonFinite`]; otherwise radii, cylinder
+    /// half-heights and box half-extents must be > 0 m, a capsule's half-height ≥ 0 m (0 is a
+    /// sphere), a convex hull needs at least 4 points not all in one plane (within
+    /// [`CONVEX_HULL_FLATNESS`] of their extent), a triangle mesh at least one triangle and
+    /// indices within its vertices; else [`Error::InvalidArgument`]. The one validation of tool
+    /// shapes, used by [`World::add_tool`](crate::World::add_tool) and the C API.
+    pub fn validate(&self) -> Result<(), Error> {
+        match self {
+            ToolShape::Sphere { radius } => check_tool_size("tool radius", *radius),
+            ToolShape::Capsule {
+                half_height,
+                radius,
+            } => {
+                if *half_height != 0.0 {
+                    check_tool_size("tool half_height", *half_height)?;
+                }
+                check_tool_size("tool radius", *radius)
+            }
+            ToolShape::Cylinder {
+                half_height,
+                radius,
+            } => {
+                check_tool_size("tool half_height", *half_height)?;
+                check_tool_size("tool radius", *radius)
+            }
+            ToolShape::Cuboid { half_extents } => (0..3).try_for_each(|k| {
+                check_tool_size(&format!("tool half_extents[{k}]"), half_extents[k])
+            }),
+            ToolShape::ConvexHull { points } => check_hull_points(points),
+            ToolShape::TriMesh {
+                vertices,
+                triangles,
+            } => {
+                check_finite_points("tool vertices", vertices)?;
+                if triangles.is_empty() {
+                    return Err(Error::InvalidArgument(
+                        "tool triangle mesh has no triangle".into(),
+                    ));
+                }
+                if let Some(t) = triangles
+                    .iter()
+                    .position(|t| t.iter().any(|&k| k as usize >= vertices.len()))
+                {
+                    return Err(Error::InvalidArgument(format!(
+                        "tool triangle {t} references a vertex out of range ({} vertices)",
+                        vertices.len()
+                    )));
+                }
+                check_tool_mesh(vertices, triangles)
+            }
+        }
+    }
+}
+
+/// `value` is finite ([`Error::NonFinite`] otherwise) and in [`TOOL_SIZE_RANGE`] m
+/// ([`Error::InvalidArgument`] otherwise); `what` names it in the message.
+fn check_tool_size(what: &str, value: Real) -> Result<(), Error> {
+    check_finite(what, value)?;
+    let (lo, hi) = TOOL_SIZE_RANGE;
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{what} must be in [{lo:e}, {hi:e}] m, got {value:e}"
+        )))
+    }
+}
+
+/// Every point finite ([`Error::NonFinite`] naming `what` and the index otherwise).
+fn check_finite_points(what: &str, points: &[Vec3]) -> Result<(), Error> {
+    match points.iter().position(|p| !is_finite_vec(p)) {
+        Some(i) => Err(Error::NonFinite(format!("{what}[{i}]"))),
+        None => Ok(()),
+    }
+}
+
+/// At least 4 finite points, not all in one plane.
+fn check_hull_points(points: &[Vec3]) -> Result<(), Error> {
+    check_finite_points("convex hull points", points)?;
+    if points.len() < 4 {
+        return Err(Error::InvalidArgument(format!(
+            "a convex hull needs at least 4 points, got {}",
+            points.len()
+        )));
+    }
+    let a = points[0];
+    let farthest = |f: &dyn Fn(&Vec3) -> Real| points.iter().map(f).fold(0.0, Real::max);
+    let extent = farthest(&|p| (p - a).norm());
+    let b = *points
+        .iter()
+        .max_by(|p, q| (*p - a).norm().total_cmp(&(*q - a).norm()))
+        .unwrap_or(&a);
+    let c = *points
+        .iter()
+        .max_by(|p, q| {
+            let d = |x: &Vec3| (b - a).cross(&(x - a)).norm();
+            d(p).total_cmp(&d(q))
+        })
+        .unwrap_or(&a);
+    let normal = (b - a).cross(&(c - a)).try_normalize(0.0);
+    let height = normal.map_or(0.0, |n| farthest(&|p| n.dot(&(p - a)).abs()));
+    if !(extent > 0.0 && height > CONVEX_HULL_FLATNESS * extent) {
+        return Err(Error::InvalidArgument(
+            "convex hull points are all in one plane (or on one line or point)".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Quaternions of a smaller norm are rejected as zero by [`Pose::from_components`].
+pub const MIN_QUATERNION_NORM: Real = 1e-12;
+
 /// A rigid pose: position (m) of the tool origin and orientation, both in the world frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pose {
@@ -64,8 +181,9 @@ impl Pose {
         }
     }
 
-    /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised on use.
-    /// Rejects NaN/Inf and a (near) zero quaternion.
+    /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised here. NaN/Inf give
+    /// [`Error::NonFinite`], a quaternion of norm below [`MIN_QUATERNION_NORM`]
+    /// [`Error::InvalidArgument`]. The one conversion of raw poses (the C API uses it too).
     pub fn from_components(position: [Real; 3], quaternion: [Real; 4]) -> Result<Self, Error> {
         let p = Vec3::from(position);
         if !is_finite_vec(&p) || quaternion.iter().any(|c| !c.is_finite()) {
@@ -74,7 +192,7 @@ impl Pose {
         let [w, x, y, z] = quaternion;
         let q = nalgebra::Quaternion::new(w, x, y, z);
         let norm = q.norm();
-        if norm < 1e-12 {
+        if norm < MIN_QUATERNION_NORM {
             return Err(Error::InvalidArgument(
                 "tool orientation: zero quaternion".into(),
             ));
@@ -120,6 +238,19 @@ pub struct ToolOptions {
     /// Spacing (m) of the surface samples in [`ContactMode::SampledPoints`](crate::ContactMode);
     /// `None` uses the particle radius of the first body.
     pub sample_spacing: Option<Real>,
+}
+
+impl ToolOptions {
+    /// Check the options: friction coefficients finite with 0 ≤ μ_k ≤ μ_s, a given sample
+    /// spacing finite and > 0 m. NaN or ±Inf give [`Error::NonFinite`], other bad values
+    /// [`Error::InvalidArgument`].
+    pub fn validate(&self) -> Result<(), Error> {
+        check_friction(self.friction_static, self.friction_kinetic)?;
+        if let Some(s) = self.sample_spacing {
+            check_tool_size("options.sample_spacing", s)?;
+        }
+        Ok(())
+    }
 }
 
 impl Default for ToolOptions {
@@ -193,81 +324,42 @@ impl Tool {
         if !pose.is_valid() {
             return Err(Error::NonFinite("tool pose".into()));
         }
-        check_friction(options.friction_static, options.friction_kinetic)?;
-        let positive = |name: &str, v: Real| {
-            let (lo, hi) = TOOL_SIZE_RANGE;
-            if (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(Error::InvalidArgument(format!(
-                    "tool {name} must be in [{lo:e}, {hi:e}] m, got {v:e}"
-                )))
-            }
-        };
-        let to_points = |v: &[Vec3]| -> Result<Vec<Point<Real>>, Error> {
-            if v.iter().any(|p| !is_finite_vec(p)) {
-                return Err(Error::NonFinite("tool vertices".into()));
-            }
-            Ok(v.iter().map(|p| Point::from(*p)).collect())
-        };
+        options.validate()?;
+        description.validate()?;
+        let to_points =
+            |v: &[Vec3]| -> Vec<Point<Real>> { v.iter().map(|p| Point::from(*p)).collect() };
         let shape = match &description {
-            ToolShape::Sphere { radius } => {
-                positive("radius", *radius)?;
-                SharedShape::ball(*radius)
-            }
+            ToolShape::Sphere { radius } => SharedShape::ball(*radius),
             ToolShape::Capsule {
                 half_height,
                 radius,
-            } => {
-                positive("radius", *radius)?;
-                positive("half height", *half_height)?;
-                SharedShape::capsule_y(*half_height, *radius)
-            }
+            } => SharedShape::capsule_y(*half_height, *radius),
             ToolShape::Cylinder {
                 half_height,
                 radius,
-            } => {
-                positive("radius", *radius)?;
-                positive("half height", *half_height)?;
-                SharedShape::cylinder(*half_height, *radius)
-            }
+            } => SharedShape::cylinder(*half_height, *radius),
             ToolShape::Cuboid { half_extents } => {
-                for k in 0..3 {
-                    positive("half extent", half_extents[k])?;
-                }
                 SharedShape::cuboid(half_extents.x, half_extents.y, half_extents.z)
             }
-            ToolShape::ConvexHull { points } => SharedShape::convex_hull(&to_points(points)?)
+            ToolShape::ConvexHull { points } => SharedShape::convex_hull(&to_points(points))
                 .ok_or_else(|| {
                     Error::InvalidArgument("convex hull of the tool points is degenerate".into())
                 })?,
             ToolShape::TriMesh {
                 vertices,
                 triangles,
-            } => {
-                if triangles
-                    .iter()
-                    .any(|t| t.iter().any(|&k| k as usize >= vertices.len()))
-                {
-                    return Err(Error::InvalidArgument(
-                        "tool triangle references a vertex out of range".into(),
-                    ));
-                }
-                check_tool_mesh(vertices, triangles)?;
-                SharedShape::trimesh_with_flags(
-                    to_points(vertices)?,
-                    triangles.clone(),
-                    TriMeshFlags::ORIENTED
-                        | TriMeshFlags::MERGE_DUPLICATE_VERTICES
-                        | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES,
-                )
-                .map_err(|e| Error::InvalidArgument(format!("tool triangle mesh: {e:?}")))?
-            }
+            } => SharedShape::trimesh_with_flags(
+                to_points(vertices),
+                triangles.clone(),
+                TriMeshFlags::ORIENTED
+                    | TriMeshFlags::MERGE_DUPLICATE_VERTICES
+                    | TriMeshFlags::DELETE_DEGENERATE_TRIANGLES,
+            )
+            .map_err(|e| Error::InvalidArgument(format!("tool triangle mesh: {e:?}")))?,
         };
         let aabb = shape.compute_local_aabb();
         let bounding_radius = aabb.center().coords.norm() + aabb.half_extents().norm();
         let spacing = options.sample_spacing.unwrap_or(default_spacing);
-        positive("sample spacing", spacing)?;
         let (samples, sample_radius) = crate::collision::sampling::sample_surface(&shape, spacing)
             .map_err(Error::InvalidArgument)?;
         Ok(Tool {
@@ -387,11 +479,15 @@ pub fn check_tool_mesh(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), 
     Ok(())
 }
 
-/// Check a pair of friction coefficients: finite, ≥ 0, and μ_k ≤ μ_s.
+/// Check a pair of friction coefficients: finite ([`Error::NonFinite`]), ≥ 0 and μ_k ≤ μ_s
+/// ([`Error::InvalidArgument`]).
 pub(crate) fn check_friction(mu_s: Real, mu_k: Real) -> Result<(), Error> {
-    if !(mu_s.is_finite() && mu_k.is_finite() && mu_s >= 0.0 && mu_k >= 0.0 && mu_k <= mu_s) {
+    check_finite("friction_static", mu_s)?;
+    check_finite("friction_kinetic", mu_k)?;
+    if !(mu_s >= 0.0 && mu_k >= 0.0 && mu_k <= mu_s) {
         return Err(Error::InvalidArgument(format!(
-            "friction needs finite 0 <= mu_k <= mu_s, got mu_s {mu_s}, mu_k {mu_k}"
+            "friction needs 0 <= friction_kinetic <= friction_static, got static {mu_s}, \
+             kinetic {mu_k}"
         )));
     }
     Ok(())

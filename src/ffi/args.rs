@@ -1,5 +1,8 @@
-//! Argument checks shared by the exports: NULL pointers, finiteness, ranges, slices from
-//! `(pointer, length)` pairs, and access to a world handle.
+//! Argument conversions shared by the exports: NULL pointers, finiteness of raw input arrays,
+//! slices from `(pointer, length)` pairs, and access to a world handle. Value ranges are not
+//! checked here: the core's validators (`Settings::validate`, `BodyOptions::validate`,
+//! `ToolShape::validate`, `ToolOptions::validate`, `Pose::from_components`, ...) are the one
+//! validation path, and their errors become statuses and last-error messages.
 
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::status::ts_status;
@@ -18,18 +21,6 @@ pub fn non_null<T>(p: *const T, name: &str) -> FfiResult {
     }
 }
 
-/// `TS_STATUS_NON_FINITE` when `v` is NaN or ±Inf.
-pub fn finite(v: f64, name: &str) -> FfiResult {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(fail(
-            ts_status::NonFinite,
-            format!("{name} is not finite ({v})"),
-        ))
-    }
-}
-
 /// `TS_STATUS_NON_FINITE` when any of `v` is NaN or ±Inf.
 pub fn all_finite(v: &[f64], name: &str) -> FfiResult {
     match v.iter().position(|x| !x.is_finite()) {
@@ -38,32 +29,6 @@ pub fn all_finite(v: &[f64], name: &str) -> FfiResult {
             ts_status::NonFinite,
             format!("{name}[{i}] is not finite ({})", v[i]),
         )),
-    }
-}
-
-/// Finite and strictly positive: `TS_STATUS_NON_FINITE` or `TS_STATUS_INVALID_ARGUMENT`.
-pub fn positive(v: f64, name: &str) -> FfiResult {
-    finite(v, name)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(fail(
-            ts_status::InvalidArgument,
-            format!("{name} must be > 0 (got {v})"),
-        ))
-    }
-}
-
-/// Finite and non-negative: `TS_STATUS_NON_FINITE` or `TS_STATUS_INVALID_ARGUMENT`.
-pub fn non_negative(v: f64, name: &str) -> FfiResult {
-    finite(v, name)?;
-    if v >= 0.0 {
-        Ok(())
-    } else {
-        Err(fail(
-            ts_status::InvalidArgument,
-            format!("{name} must be >= 0 (got {v})"),
-        ))
     }
 }
 

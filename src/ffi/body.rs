@@ -3,8 +3,7 @@
 
 use crate::body::{Body, BodyOptions, Material};
 use crate::ffi::args::{
-    all_finite, element_count, input_slice, non_null, positive, read_vec3, world_mut, world_ref,
-    write,
+    all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,
 };
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
@@ -64,7 +63,8 @@ impl From<&BodyOptions> for ts_body_options {
     }
 }
 
-/// The Rust body options from the C material and (optional) options.
+/// The Rust body options from the C material and (optional) options, checked by
+/// [`BodyOptions::validate`] (the one validation of materials and body options).
 ///
 /// # Safety
 ///
@@ -76,10 +76,6 @@ unsafe fn body_options(
     non_null(material, "material")?;
     // SAFETY: checked non-NULL, readable by contract; any bit pattern is a valid value.
     let m = unsafe { *material };
-    all_finite(
-        &[m.youngs_modulus, m.poisson_ratio, m.density],
-        "material (youngs_modulus, poisson_ratio, density)",
-    )?;
     let mut o = BodyOptions {
         material: Material {
             youngs_modulus: m.youngs_modulus,
@@ -91,16 +87,13 @@ unsafe fn body_options(
     if !options.is_null() {
         // SAFETY: non-NULL, readable by contract.
         let c = unsafe { *options };
-        all_finite(
-            &[c.support_radius, c.particle_radius],
-            "options (support_radius, particle_radius)",
-        )?;
-        // 0 means automatic; every range is checked by the core (BodyOptions::check_radii).
+        // 0 means automatic; any other value is given to the core, which validates it.
         let radius = |v: f64| (v != 0.0).then_some(v);
         o.support_radius = radius(c.support_radius);
         o.particle_radius = radius(c.particle_radius);
         o.target_neighbours = c.target_neighbours;
     }
+    o.validate()?;
     Ok(o)
 }
 
@@ -215,7 +208,7 @@ pub unsafe extern "C" fn ts_world_add_body_from_file(
         let o = unsafe { body_options(material, options)? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
-        positive(scale, "scale")?;
+        mesh::validate_scale(scale)?;
         let (mesh, report) = mesh::load(&path, scale)?;
         let id = h.add_mesh(&mesh, report.original_node_index, &o)?;
         // SAFETY: checked non-NULL.
@@ -322,13 +315,6 @@ pub unsafe extern "C" fn ts_body_fix_particles(
         let idx = unsafe { input_slice(indices, count, "indices")? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
-        let n = h.body(body)?.particle_count();
-        if let Some(bad) = idx.iter().find(|&&i| i as usize >= n) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                format!("indices: particle {bad} out of range (body {body} has {n} particles)"),
-            ));
-        }
         h.mutate(|w| w.fix_particles(BodyId(body), idx))
     })
 }
@@ -356,15 +342,6 @@ pub unsafe extern "C" fn ts_body_fix_box(
         let h = unsafe { world_mut(world)? };
         // SAFETY: checked non-NULL; 3 doubles each by contract.
         let (lo, hi) = unsafe { (read_vec3(min), read_vec3(max)) };
-        all_finite(lo.as_slice(), "min")?;
-        all_finite(hi.as_slice(), "max")?;
-        if (0..3).any(|k| lo[k] > hi[k]) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "min must be <= max on every axis",
-            ));
-        }
-        h.body(body)?;
         let n = h.mutate(|w| w.fix_box(BodyId(body), lo, hi))?;
         if !out_fixed.is_null() {
             // SAFETY: non-NULL, writable by contract.
@@ -739,4 +716,125 @@ pub unsafe extern "C" fn ts_body_mass(
 ) -> ts_status {
     // SAFETY: contract of this function.
     unsafe { body_value(world, body, out_mass, |b| b.mass()) }
+}
+
+/// Set the positions and velocities of every particle of a body, e.g. an initial condition or
+/// a reset: `positions` holds particle_count x 3 doubles (m, world frame), `velocities`
+/// particle_count x 3 doubles (m/s); `positions_len` and `velocities_len` are their lengths in
+/// doubles and must both be 3 * particle_count (else TS_STATUS_INVALID_ARGUMENT). NaN/Inf give
+/// TS_STATUS_NON_FINITE. Fixed particles take the given position and zero velocity (and stay
+/// fixed there). Nothing changes on error. Allocates (not for every haptic frame).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `positions` is NULL or holds `positions_len` readable
+/// doubles; `velocities` is NULL or holds `velocities_len` readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_set_state(
+    world: *mut ts_world,
+    body: u32,
+    positions: *const f64,
+    positions_len: usize,
+    velocities: *const f64,
+    velocities_len: usize,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let x = unsafe { input_slice(positions, positions_len, "positions")? };
+        // SAFETY: contract of this function.
+        let v = unsafe { input_slice(velocities, velocities_len, "velocities")? };
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        let vectors = |xyz: &[f64], name: &str| -> FfiResult<Vec<Vec3>> {
+            if xyz.len() % 3 != 0 {
+                return Err(fail(
+                    ts_status::InvalidArgument,
+                    format!("{name}_len {} is not a multiple of 3", xyz.len()),
+                ));
+            }
+            Ok(xyz
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect())
+        };
+        let (x, v) = (vectors(x, "positions")?, vectors(v, "velocities")?);
+        h.mutate(|w| w.set_body_state(BodyId(body), &x, &v))
+    })
+}
+
+/// Whether each particle is fixed (1) or free (0) into `out`: particle_count bytes. `len` in
+/// bytes; below particle_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not
+/// allocate.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out` is NULL or holds `len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_fixed_flags(
+    world: *const ts_world,
+    body: u32,
+    out: *mut u8,
+    len: usize,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe {
+        body_array(
+            world,
+            body,
+            out,
+            len,
+            "fixed flags",
+            "bytes",
+            |_, b| b.particle_count(),
+            |_, b, dst| put(dst, (0..b.particle_count()).map(|i| b.is_fixed(i) as u8)),
+        )
+    }
+}
+
+/// Contact radius of the body's particles (m) into *out_radius: a particle touches a tool
+/// when its centre comes closer than this to the tool's surface.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_radius` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_body_particle_radius(
+    world: *const ts_world,
+    body: u32,
+    out_radius: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { body_value(world, body, out_radius, |b| b.particle_radius()) }
+}
+
+/// Set the friction between two bodies where they touch (organ-organ contact; frictionless
+/// unless set): static coefficient `friction_static` (mu_s) and kinetic `friction_kinetic`
+/// (mu_k), dimensionless, 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give
+/// TS_STATUS_NON_FINITE). The pair is unordered; `body_a` may equal `body_b` (self-contact,
+/// see ts_settings.self_contact). Setting a pair again replaces its coefficients. Nothing
+/// changes on error.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_set_body_pair_friction(
+    world: *mut ts_world,
+    body_a: u32,
+    body_b: u32,
+    friction_static: f64,
+    friction_kinetic: f64,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| {
+            w.set_body_pair_friction(
+                BodyId(body_a),
+                BodyId(body_b),
+                friction_static,
+                friction_kinetic,
+            )
+        })
+    })
 }

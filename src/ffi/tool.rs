@@ -1,17 +1,17 @@
-//! Tools: kinematic rigid instruments (sphere, capsule, cylinder, box, OBJ mesh), their poses
+//! Tools: kinematic rigid instruments (sphere, capsule, cylinder, box, convex hull, triangle
+//! mesh from arrays or OBJ), adding and removing them, their poses, friction
 //! and the contact wrench the tissue exerts on them.
 
 use crate::collision::tool::{Pose, ToolOptions, ToolShape};
-use crate::ffi::args::{all_finite, non_negative, non_null, positive, world_mut, world_ref, write};
+use crate::ffi::args::{element_count, input_slice, non_null, world_mut, world_ref, write};
 use crate::ffi::body::c_path;
-use crate::ffi::error::{fail, FfiResult};
+use crate::ffi::error::FfiResult;
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::{Quat, Vec3};
+use crate::math::Vec3;
 use crate::mesh;
 use crate::world::ToolId;
-use nalgebra::Quaternion;
 use std::ffi::c_char;
 
 /// A rigid pose in the world frame: the position of the tool origin and its orientation.
@@ -21,29 +21,16 @@ pub struct ts_pose {
     /// Position of the tool origin (m, world frame), [x, y, z].
     pub position: [f64; 3],
     /// Orientation as a quaternion [w, x, y, z] (local to world); normalised on use, so it
-    /// need not be unit length, but it must not be zero. Identity: {1, 0, 0, 0}.
+    /// need not be unit length, but its norm must be at least 1e-12 (else
+    /// TS_STATUS_INVALID_ARGUMENT). Identity: {1, 0, 0, 0}.
     pub orientation: [f64; 4],
 }
 
 impl ts_pose {
-    /// The Rust pose: NaN/Inf give TS_STATUS_NON_FINITE, a zero quaternion
-    /// TS_STATUS_INVALID_ARGUMENT; the quaternion is normalised.
+    /// The Rust pose by [`Pose::from_components`] (the one quaternion check and normalisation):
+    /// NaN/Inf give TS_STATUS_NON_FINITE, a (near) zero quaternion TS_STATUS_INVALID_ARGUMENT.
     pub fn to_pose(&self) -> FfiResult<Pose> {
-        all_finite(&self.position, "pose.position")?;
-        all_finite(&self.orientation, "pose.orientation")?;
-        let [w, x, y, z] = self.orientation;
-        let q = Quaternion::new(w, x, y, z);
-        let norm = q.norm();
-        if !(norm.is_finite() && norm > 1e-12) {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "pose.orientation: the quaternion must not be zero",
-            ));
-        }
-        Ok(Pose {
-            position: Vec3::new(self.position[0], self.position[1], self.position[2]),
-            orientation: Quat::new_unchecked(q / norm),
-        })
+        Ok(Pose::from_components(self.position, self.orientation)?)
     }
 }
 
@@ -81,22 +68,16 @@ impl From<&ToolOptions> for ts_tool_options {
 }
 
 impl ts_tool_options {
-    /// The Rust options, checked.
+    /// The Rust options (sample_spacing 0 means automatic), checked by
+    /// [`ToolOptions::validate`].
     pub fn to_options(&self) -> FfiResult<ToolOptions> {
-        non_negative(self.friction_static, "options.friction_static")?;
-        non_negative(self.friction_kinetic, "options.friction_kinetic")?;
-        non_negative(self.sample_spacing, "options.sample_spacing")?;
-        if self.friction_kinetic > self.friction_static {
-            return Err(fail(
-                ts_status::InvalidArgument,
-                "options.friction_kinetic must be <= options.friction_static",
-            ));
-        }
-        Ok(ToolOptions {
+        let o = ToolOptions {
             friction_static: self.friction_static,
             friction_kinetic: self.friction_kinetic,
-            sample_spacing: (self.sample_spacing > 0.0).then_some(self.sample_spacing),
-        })
+            sample_spacing: (self.sample_spacing != 0.0).then_some(self.sample_spacing),
+        };
+        o.validate()?;
+        Ok(o)
     }
 }
 
@@ -114,7 +95,8 @@ pub struct ts_wrench {
     pub contact_count: u32,
 }
 
-/// Add a tool of `shape` after checking the common arguments.
+/// Add a tool of `shape` (built after the pose and options are converted and checked, so that
+/// a bad pose fails before a file is read); every value is checked by the core.
 ///
 /// # Safety
 ///
@@ -177,16 +159,14 @@ pub unsafe extern "C" fn ts_world_add_tool_sphere(
     options: *const ts_tool_options,
     out_tool: *mut u32,
 ) -> ts_status {
-    let shape = || {
-        positive(radius, "radius")?;
-        Ok(ToolShape::Sphere { radius })
-    };
+    let shape = || Ok(ToolShape::Sphere { radius });
     // SAFETY: contract of this function.
     unsafe { add_tool(world, shape, pose, options, out_tool) }
 }
 
-/// Add a capsule tool along its local y axis: `half_height` (m, >= 0) is half the distance
-/// between the hemisphere centres, `radius` (m, > 0). Otherwise as ts_world_add_tool_sphere.
+/// Add a capsule tool along its local y axis: `half_height` (m, >= 0; 0 gives a sphere) is half
+/// the distance between the hemisphere centres, `radius` (m, > 0). Otherwise as
+/// ts_world_add_tool_sphere.
 ///
 /// # Safety
 ///
@@ -201,8 +181,6 @@ pub unsafe extern "C" fn ts_world_add_tool_capsule(
     out_tool: *mut u32,
 ) -> ts_status {
     let shape = || {
-        non_negative(half_height, "half_height")?;
-        positive(radius, "radius")?;
         Ok(ToolShape::Capsule {
             half_height,
             radius,
@@ -228,8 +206,6 @@ pub unsafe extern "C" fn ts_world_add_tool_cylinder(
     out_tool: *mut u32,
 ) -> ts_status {
     let shape = || {
-        positive(half_height, "half_height")?;
-        positive(radius, "radius")?;
         Ok(ToolShape::Cylinder {
             half_height,
             radius,
@@ -259,9 +235,6 @@ pub unsafe extern "C" fn ts_world_add_tool_box(
     let shape = || {
         // SAFETY: non-NULL, 3 readable doubles by contract.
         let e = unsafe { crate::ffi::args::read_vec3(half_extents) };
-        for k in 0..3 {
-            positive(e[k], &format!("half_extents[{k}]"))?;
-        }
         Ok(ToolShape::Cuboid { half_extents: e })
     };
     // SAFETY: contract of this function.
@@ -291,7 +264,7 @@ pub unsafe extern "C" fn ts_world_add_tool_mesh_file(
     let shape = || {
         // SAFETY: non-NULL and NUL-terminated by contract.
         let path = unsafe { c_path(path, "path")? };
-        positive(scale, "scale")?;
+        mesh::validate_scale(scale)?;
         let surface = mesh::read_obj(&path, scale)?;
         Ok(ToolShape::TriMesh {
             vertices: surface.vertices,
@@ -395,6 +368,153 @@ pub unsafe extern "C" fn ts_tool_contact_count(
         let n = h.world.tool(ToolId(tool))?.wrench().contact_count;
         // SAFETY: checked non-NULL.
         unsafe { write(out_count, n) };
+        Ok(())
+    })
+}
+
+/// `count` points given as `count x 3` doubles at `xyz` (the length check of a C array; the
+/// values are checked by the core).
+///
+/// # Safety
+///
+/// `xyz` is NULL or holds `3 * count` readable doubles.
+unsafe fn points(xyz: *const f64, count: usize, name: &str) -> FfiResult<Vec<Vec3>> {
+    let n = element_count::<f64>(count, 3, name)?;
+    // SAFETY: contract of the caller.
+    let xyz = unsafe { input_slice(xyz, n, name)? };
+    Ok(xyz
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect())
+}
+
+/// Add a convex tool: the convex hull of `point_count` points (`points` holds point_count x 3
+/// doubles, x, y, z per point, m, tool frame). At least 4 points not all in one plane (else
+/// TS_STATUS_INVALID_ARGUMENT); NaN/Inf give TS_STATUS_NON_FINITE. Points inside the hull are
+/// ignored. Otherwise as ts_world_add_tool_sphere. Allocates.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `points` is NULL or holds 3 * point_count readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_convex_hull(
+    world: *mut ts_world,
+    points: *const f64,
+    point_count: usize,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if points.is_null() {
+        return guard(|| non_null(points, "points"));
+    }
+    let shape = || {
+        // SAFETY: non-NULL, 3 * point_count readable doubles by contract.
+        let points = unsafe { self::points(points, point_count, "points")? };
+        Ok(ToolShape::ConvexHull { points })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Add a triangle-mesh tool from arrays: `vertices` holds vertex_count x 3 doubles (m, tool
+/// frame), `triangles` holds triangle_count x 3 vertex indices (0-based, counter-clockwise seen
+/// from outside). An index >= vertex_count or no triangle gives TS_STATUS_INVALID_ARGUMENT,
+/// NaN/Inf TS_STATUS_NON_FINITE. Otherwise as ts_world_add_tool_sphere. Allocates.
+///
+/// # Safety
+///
+/// As ts_world_add_tool_sphere; `vertices` is NULL or holds 3 * vertex_count readable doubles;
+/// `triangles` is NULL or holds 3 * triangle_count readable uint32_t.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_tool_mesh(
+    world: *mut ts_world,
+    vertices: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    pose: *const ts_pose,
+    options: *const ts_tool_options,
+    out_tool: *mut u32,
+) -> ts_status {
+    if vertices.is_null() || triangles.is_null() {
+        return guard(|| {
+            non_null(vertices, "vertices")?;
+            non_null(triangles, "triangles")
+        });
+    }
+    let shape = || {
+        // SAFETY: non-NULL, 3 * vertex_count readable doubles by contract.
+        let vertices = unsafe { points(vertices, vertex_count, "vertices")? };
+        let n = element_count::<u32>(triangle_count, 3, "triangle_count")?;
+        // SAFETY: non-NULL, 3 * triangle_count readable uint32_t by contract.
+        let idx = unsafe { input_slice(triangles, n, "triangles")? };
+        Ok(ToolShape::TriMesh {
+            vertices,
+            triangles: idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
+    };
+    // SAFETY: contract of this function.
+    unsafe { add_tool(world, shape, pose, options, out_tool) }
+}
+
+/// Remove a tool: from the next ts_world_step on it no longer touches the tissue. Its id is
+/// not reused: every later call with it gives TS_STATUS_UNKNOWN_TOOL, and tools added later get
+/// new ids. A state saved before the removal no longer restores (TS_STATUS_BAD_STATE).
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_remove_tool(world: *mut ts_world, tool: u32) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| w.remove_tool(ToolId(tool)))
+    })
+}
+
+/// Set a tool's friction with the tissue, from the next step on: static coefficient
+/// `friction_static` (mu_s) and kinetic `friction_kinetic` (mu_k), dimensionless, with
+/// 0 <= mu_k <= mu_s (else TS_STATUS_INVALID_ARGUMENT; NaN/Inf give TS_STATUS_NON_FINITE). The
+/// tool is unchanged on error.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_set_friction(
+    world: *mut ts_world,
+    tool: u32,
+    friction_static: f64,
+    friction_kinetic: f64,
+) -> ts_status {
+    guard(|| {
+        // SAFETY: contract of this function.
+        let h = unsafe { world_mut(world)? };
+        h.mutate(|w| w.set_tool_friction(ToolId(tool), friction_static, friction_kinetic))
+    })
+}
+
+/// The options a tool has now (friction coefficients, dimensionless; sample spacing in m, 0 when
+/// automatic) into *out_options.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_options` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_tool_get_options(
+    world: *const ts_world,
+    tool: u32,
+    out_options: *mut ts_tool_options,
+) -> ts_status {
+    guard(|| {
+        non_null(out_options, "out_options")?;
+        // SAFETY: contract of this function.
+        let h = unsafe { world_ref(world)? };
+        let o = ts_tool_options::from(h.world.tool(ToolId(tool))?.options());
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_options, o) };
         Ok(())
     })
 }

@@ -1,7 +1,7 @@
 //! `ts_world`: the opaque world handle, its settings and its step.
 
 use crate::error::Error;
-use crate::ffi::args::{all_finite, finite, non_null, world_mut, world_ref, write};
+use crate::ffi::args::{non_null, world_mut, world_ref, write};
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
@@ -116,24 +116,11 @@ impl From<&Settings> for ts_settings {
 }
 
 impl ts_settings {
-    /// The Rust settings, after rejecting NaN/Inf and unknown enum values; ranges are checked
-    /// by [`Settings::validate`] where the settings are used.
+    /// The Rust settings, converted field by field (an unknown contact_mode value gives
+    /// TS_STATUS_INVALID_ARGUMENT). Values are not checked here: [`Settings::validate`] does
+    /// that in [`World::new`] and [`World::set_settings`].
+    #[allow(clippy::needless_update)]
     pub fn to_settings(&self) -> FfiResult<Settings> {
-        finite(self.dt, "settings.dt")?;
-        all_finite(&self.gravity, "settings.gravity")?;
-        for (name, v) in [
-            ("settings.stability_margin", self.stability_margin),
-            ("settings.damping_mass", self.damping_mass),
-            ("settings.damping_stiffness", self.damping_stiffness),
-            ("settings.hourglass_stiffness", self.hourglass_stiffness),
-            ("settings.volume_compliance", self.volume_compliance),
-            (
-                "settings.max_depenetration_speed",
-                self.max_depenetration_speed,
-            ),
-        ] {
-            finite(v, name)?;
-        }
         // Infinity switches a divergence check off; NaN is refused by Settings::validate.
         let divergence = DivergenceLimits {
             max_speed: self.divergence_max_speed,
@@ -155,8 +142,7 @@ impl ts_settings {
         };
         // `..Settings::default()` keeps this compiling when the core adds a setting; such a
         // setting keeps its default until it is added to ts_settings.
-        #[allow(clippy::needless_update)]
-        let s = Settings {
+        Ok(Settings {
             dt: self.dt,
             gravity: Vec3::new(self.gravity[0], self.gravity[1], self.gravity[2]),
             min_substeps: self.min_substeps,
@@ -176,9 +162,7 @@ impl ts_settings {
             max_depenetration_speed: self.max_depenetration_speed,
             divergence,
             ..Settings::default()
-        };
-        s.validate()?;
-        Ok(s)
+        })
     }
 }
 
@@ -246,8 +230,9 @@ pub unsafe extern "C" fn ts_settings_default(out: *mut ts_settings) -> ts_status
     })
 }
 
-/// Create an empty world with `settings` (validated: NaN/Inf give TS_STATUS_NON_FINITE, out of
-/// range values TS_STATUS_INVALID_ARGUMENT) and store its handle in *out_world. Release it with
+/// Create an empty world with `settings` (validated by the core: NaN/Inf give
+/// TS_STATUS_NON_FINITE, out of range values TS_STATUS_INVALID_ARGUMENT, the message names the
+/// field) and store its handle in *out_world. Release it with
 /// ts_world_free.
 ///
 /// # Safety
@@ -412,7 +397,8 @@ pub unsafe extern "C" fn ts_world_body_count(
     unsafe { world_value(world, out_count, "out_count", |w| w.body_count() as u32) }
 }
 
-/// Number of tools in the world (their ids are 0 .. count-1).
+/// Number of tools in the world, removed tools not counted (tool ids are 0, 1, 2, ... in
+/// order of creation and never reused, so after ts_world_remove_tool they are not 0 .. count-1).
 ///
 /// # Safety
 ///

@@ -98,6 +98,13 @@ pub struct SurfaceMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// Check a load scale factor (mesh units → m): finite, else [`Error::NonFinite`](crate::Error),
+/// and positive, else [`Error::InvalidArgument`](crate::Error). The readers apply this rule
+/// (reporting a [`MeshError`] naming the file); the C API checks it before opening a file.
+pub fn validate_scale(scale: Real) -> Result<(), crate::Error> {
+    crate::error::check_positive("scale", scale, "")
+}
+
 /// Load a tetrahedral mesh, choosing the reader from the file name: `.msh` (Gmsh v1, 2.2 or
 /// 4.1 ASCII), `.node` / `.ele` (TetGen, 0- or 1-based), `.vtk` (legacy VTK ASCII
 /// `UNSTRUCTURED_GRID`). Node positions are multiplied by `scale` (mesh units → m).

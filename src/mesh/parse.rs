@@ -26,16 +26,9 @@ pub(crate) fn prealloc(declared: usize) -> usize {
     declared.min(1 << 20)
 }
 
-/// Check that a load scale factor is finite and positive.
+/// Check a load scale factor with [`super::validate_scale`], as a [`MeshError`] naming the file.
 pub(crate) fn check_scale(path: &Path, scale: Real) -> Result<(), MeshError> {
-    if scale.is_finite() && scale > 0.0 {
-        Ok(())
-    } else {
-        Err(MeshError::file(
-            path,
-            format!("scale must be finite and > 0, got {scale}"),
-        ))
-    }
+    super::validate_scale(scale).map_err(|e| MeshError::file(path, e.to_string()))
 }
 
 /// The meaningful lines of a text: comments (from `comment` to the end of the line) stripped,
