@@ -111,6 +111,10 @@ typedef enum ts_status {
      * The world is unusable because an earlier call panicked while changing it; free it.
      */
     TS_STATUS_POISONED = 12,
+    /**
+     * No render surface with this id exists in the world.
+     */
+    TS_STATUS_UNKNOWN_RENDER_SURFACE = 13,
 } ts_status;
 
 /**
