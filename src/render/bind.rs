@@ -94,22 +94,23 @@ impl TetGrid {
             start: vec![0; (dims[0] * dims[1] * dims[2]) as usize + 1],
             tets: Vec::new(),
         };
+        let mut counts = vec![0u32; grid.start.len()];
         for (a, b) in boxes {
-            for c in grid.cells_of_box(a, b) {
-                grid.start[c + 1] += 1;
-            }
+            grid.for_cells_of_box(a, b, |c| counts[c + 1] += 1);
         }
+        grid.start = counts;
         for c in 1..grid.start.len() {
             grid.start[c] += grid.start[c - 1];
         }
         let mut fill = grid.start.clone();
-        grid.tets = vec![0; *grid.start.last().unwrap_or(&0) as usize];
+        let mut tets = vec![0; *grid.start.last().unwrap_or(&0) as usize];
         for (t, (a, b)) in boxes.iter().enumerate() {
-            for c in grid.cells_of_box(a, b) {
-                grid.tets[fill[c] as usize] = t as u32;
+            grid.for_cells_of_box(a, b, |c| {
+                tets[fill[c] as usize] = t as u32;
                 fill[c] += 1;
-            }
+            });
         }
+        grid.tets = tets;
         grid
     }
 
@@ -123,18 +124,18 @@ impl TetGrid {
         (c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])) as usize
     }
 
-    /// Linear indices of the cells overlapped by the box `[a, b]`, clamped to the grid.
-    fn cells_of_box(&self, a: &Vec3, b: &Vec3) -> impl Iterator<Item = usize> {
+    /// Call `f` with the linear index of every cell overlapped by the box `[a, b]`, clamped to
+    /// the grid.
+    fn for_cells_of_box(&self, a: &Vec3, b: &Vec3, mut f: impl FnMut(usize)) {
         let (lo, hi, d) = (self.cell_of(a), self.cell_of(b), self.dims);
-        let r = move |k: usize| lo[k].clamp(0, d[k] - 1)..=hi[k].clamp(0, d[k] - 1);
-        let (rx, ry, rz) = (r(0), r(1), r(2));
-        rz.flat_map(move |z| {
-            let rx = rx.clone();
-            ry.clone().flat_map(move |y| {
-                rx.clone()
-                    .map(move |x| (x + d[0] * (y + d[1] * z)) as usize)
-            })
-        })
+        let r = |k: usize| lo[k].clamp(0, d[k] - 1)..=hi[k].clamp(0, d[k] - 1);
+        for z in r(2) {
+            for y in r(1) {
+                for x in r(0) {
+                    f(self.index([x, y, z]));
+                }
+            }
+        }
     }
 
     /// The tetrahedra listed in cell `c` (empty outside the grid).
