@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Build the release library, check that the header compiles cleanly as C99, C11, C++11 and C++17
+# Build the release library, check that test_api.c and test_render_surface.c together call every
+# function of the header, that the header compiles cleanly as C99, C11, C++11 and C++17
 # (header_check.c), compile every C program in examples_c/ and the C++17 example hello_cpp.cpp
 # against the shared library (and test_api.c also against the static one), run them, then run
 # them again under valgrind (no errors, no definite/indirect leaks); the hostile client hostile.c
@@ -11,7 +12,9 @@
 # Environment: CARGO_TARGET_DIR (default: target), CC (default: cc), CXX (default: c++),
 # SOFA_LIVER (default:
 # $TISSUESIM_MESHES/liver.msh when TISSUESIM_MESHES is set, else data/meshes/liver.msh in the
-# repository; a missing file is a failure, not a skip), SKIP_VALGRIND=1 to skip the valgrind runs.
+# repository; a missing file is a failure, not a skip), TISSUESIM_MESHES (the folder of liver.msh
+# and liver-smooth.obj for render_surface; default data/meshes), SKIP_VALGRIND=1 to skip the
+# valgrind runs.
 set -u
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -25,6 +28,7 @@ CXX="${CXX:-c++}"
 CFLAGS=(-Wall -Wextra -Wpedantic -Werror -std=c11 -O2 -g -I"$ROOT/include")
 CXXFLAGS=(-Wall -Wextra -Wpedantic -Werror -std=c++17 -O2 -g -I"$ROOT/include")
 LIVER="${SOFA_LIVER:-${TISSUESIM_MESHES:-$ROOT/data/meshes}/liver.msh}"
+MESHES="${TISSUESIM_MESHES:-$ROOT/data/meshes}"
 mkdir -p "$OUT"
 
 passed=0
@@ -46,12 +50,17 @@ else
     finish
 fi
 
-echo "== checking that test_api.c calls every function of the header"
+echo "== checking that test_api.c and test_render_surface.c call every function of the header"
 missing=""
 for fn in $(grep -oE '\bts_[a-z0-9_]+\(' include/tissuesim.h | tr -d '(' | sort -u); do
-    grep -q "\b$fn(" examples_c/test_api.c || missing="$missing $fn"
+    cat examples_c/test_api.c examples_c/test_render_surface.c | grep -q "\b$fn(" ||
+        missing="$missing $fn"
 done
-if [ -z "$missing" ]; then pass "test_api.c covers the header"; else fail "test_api.c misses:$missing"; fi
+if [ -z "$missing" ]; then
+    pass "test_api.c + test_render_surface.c cover the header"
+else
+    fail "test_api.c + test_render_surface.c miss:$missing"
+fi
 
 echo "== checking the shared library exports exactly the header's functions"
 if command -v nm >/dev/null 2>&1; then
@@ -66,7 +75,8 @@ fi
 
 # Binaries of an earlier run must not stand in for ones that fail to compile now.
 rm -f "$OUT"/header_check_* "$OUT"/hello "$OUT"/hello_cpp "$OUT"/haptic_loop "$OUT"/sofa_liver \
-    "$OUT"/test_api "$OUT"/test_api_static "$OUT"/hostile "$OUT"/hostile_asan
+    "$OUT"/test_api "$OUT"/test_api_static "$OUT"/hostile "$OUT"/hostile_asan \
+    "$OUT"/render_surface "$OUT"/test_render_surface
 
 echo "== compiling the header as C and C++ (header_check.c)"
 for std in c99 c11; do
@@ -87,7 +97,7 @@ for std in c++11 c++17; do
 done
 
 echo "== compiling"
-PROGRAMS=(hello haptic_loop sofa_liver test_api)
+PROGRAMS=(hello haptic_loop sofa_liver test_api render_surface test_render_surface)
 for p in "${PROGRAMS[@]}"; do
     if "$CC" "${CFLAGS[@]}" "examples_c/$p.c" -L"$LIB_DIR" -ltissuesim -lm -o "$OUT/$p"; then
         pass "compile $p.c (shared)"
@@ -158,6 +168,14 @@ fi
 [ -x "$OUT/hostile" ] && run hostile -- "$OUT/hostile"
 [ -x "$OUT/hostile_asan" ] && run hostile_asan ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 -- "$OUT/hostile_asan"
+mkdir -p "$OUT/render_frames" "$OUT/render_scratch"
+rm -f "$OUT"/render_frames/*.obj
+[ -x "$OUT/render_surface" ] && run render_surface -- "$OUT/render_surface" "$MESHES" "$OUT/render_frames"
+if [ -x "$OUT/render_surface" ]; then
+    frames=$(ls "$OUT"/render_frames/liver_surface_*.obj 2>/dev/null | wc -l)
+    if [ "$frames" -eq 5 ]; then pass "render_surface wrote 5 OBJ frames"; else fail "render_surface wrote $frames OBJ frames, 5 expected"; fi
+fi
+[ -x "$OUT/test_render_surface" ] && run test_render_surface -- "$OUT/test_render_surface" "$OUT/render_scratch"
 
 if [ "${SKIP_VALGRIND:-0}" = 1 ]; then
     echo "SKIP valgrind (SKIP_VALGRIND=1)"
@@ -193,5 +211,9 @@ fi
 [ -x "$OUT/test_api_static" ] && run valgrind-test_api_static TS_STEPS=3 -- \
     "${VG[@]}" "$OUT/test_api_static"
 [ -x "$OUT/hostile" ] && run valgrind-hostile -- "${VG[@]}" "$OUT/hostile"
+[ -x "$OUT/render_surface" ] && run valgrind-render_surface TS_STEPS=4 -- \
+    "${VG[@]}" "$OUT/render_surface" "$MESHES" "$OUT/render_frames"
+[ -x "$OUT/test_render_surface" ] && run valgrind-test_render_surface -- \
+    "${VG[@]}" "$OUT/test_render_surface" "$OUT/render_scratch"
 
 finish

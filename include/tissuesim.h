@@ -111,6 +111,10 @@ typedef enum ts_status {
      * The world is unusable because an earlier call panicked while changing it; free it.
      */
     TS_STATUS_POISONED = 12,
+    /**
+     * No render surface with this id exists in the world.
+     */
+    TS_STATUS_UNKNOWN_RENDER_SURFACE = 13,
 } ts_status;
 
 /**
@@ -1075,6 +1079,145 @@ enum ts_status ts_world_save_state(struct ts_world *world,
  * `world` is NULL or a live handle; `buf` is NULL or holds `len` readable bytes.
  */
 enum ts_status ts_world_restore_state(struct ts_world *world, const uint8_t *buf, size_t len);
+
+/**
+ * Add a render surface from a Wavefront OBJ file (`v`, `vt`, `vn`, faces `a`, `a/b`, `a//c`,
+ * `a/b/c`, polygons fan-triangulated) bound to body `body`: one render vertex per distinct
+ * v/vt/vn triple of the faces. Positions are multiplied by `scale` (> 0, file units to m; use
+ * the scale the body's mesh was loaded with: the OBJ must be in the body's rest frame). Every
+ * vertex is bound once to its enclosing rest tetrahedron, or to the nearest one (extrapolated)
+ * if it lies outside the body. A missing or malformed file gives TS_STATUS_MESH_ERROR naming
+ * the file and line. The new surface's id (0, 1, ... per world) goes to *out_surface.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `path` is NULL or NUL-terminated; `out_surface` is NULL
+ * or writable.
+ */
+enum ts_status ts_world_add_render_surface_from_file(struct ts_world *world,
+                                                     uint32_t body,
+                                                     const char *path,
+                                                     double scale,
+                                                     uint32_t *out_surface);
+
+/**
+ * Add a render surface made of body `body`'s own boundary triangles (one vertex per boundary
+ * particle, no texture coordinates), for bodies without a visual mesh such as the default
+ * organ. The new surface's id goes to *out_surface.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_surface` is NULL or writable.
+ */
+enum ts_status ts_world_add_render_surface_from_boundary(struct ts_world *world,
+                                                         uint32_t body,
+                                                         uint32_t *out_surface);
+
+/**
+ * Number of render surfaces in the world into *out_count.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_count` is NULL or writable.
+ */
+enum ts_status ts_world_render_surface_count(const struct ts_world *world, size_t *out_count);
+
+/**
+ * Number of vertices of a render surface into *out_count (the length, in vertices, of the
+ * arrays of ts_render_surface_texcoords and ts_render_surface_update).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_count` is NULL or writable.
+ */
+enum ts_status ts_render_surface_vertex_count(const struct ts_world *world,
+                                              uint32_t surface,
+                                              size_t *out_count);
+
+/**
+ * Number of triangles of a render surface into *out_count.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_count` is NULL or writable.
+ */
+enum ts_status ts_render_surface_triangle_count(const struct ts_world *world,
+                                                uint32_t surface,
+                                                size_t *out_count);
+
+/**
+ * The triangles of a render surface into `out`: triangle_count x 3 vertex indices (0-based,
+ * in the file's winding). `len` is the buffer length in uint32_t; below 3 * triangle_count
+ * gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not allocate.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out` is NULL or holds `len` writable uint32_t.
+ */
+enum ts_status ts_render_surface_triangles(const struct ts_world *world,
+                                           uint32_t surface,
+                                           uint32_t *out,
+                                           size_t len);
+
+/**
+ * The texture coordinates of a render surface into `out`: vertex_count x 2 doubles (u, v per
+ * vertex; 0, 0 for vertices the file gave none). `len` is the buffer length in doubles; below
+ * 2 * vertex_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not allocate.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out` is NULL or holds `len` writable doubles.
+ */
+enum ts_status ts_render_surface_texcoords(const struct ts_world *world,
+                                           uint32_t surface,
+                                           double *out,
+                                           size_t len);
+
+/**
+ * Update a render surface from its body's current particle positions and copy the deformed
+ * vertex positions (m, world frame) into `positions_out` and the vertex normals (unit,
+ * area-weighted face normals, renormalised) into `normals_out`: vertex_count x 3 doubles each
+ * (x, y, z per vertex). `len` is the length in doubles of each buffer; below
+ * 3 * vertex_count gives TS_STATUS_BUFFER_TOO_SMALL and writes nothing. Does not allocate:
+ * call it after ts_world_step whenever a frame is drawn.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `positions_out` and `normals_out` are NULL or hold `len`
+ * writable doubles each.
+ */
+enum ts_status ts_render_surface_update(struct ts_world *world,
+                                        uint32_t surface,
+                                        double *positions_out,
+                                        double *normals_out,
+                                        size_t len);
+
+/**
+ * Write a render surface as it was at its last ts_render_surface_update (or when it was
+ * added) to a Wavefront OBJ file: v (m), vt (when the source had texture coordinates), vn and
+ * f a/b/c records. A file that cannot be written gives TS_STATUS_IO_ERROR. Allocates (not for
+ * the haptic loop).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `path` is NULL or NUL-terminated.
+ */
+enum ts_status ts_render_surface_write_obj(const struct ts_world *world,
+                                           uint32_t surface,
+                                           const char *path);
+
+/**
+ * Write a render surface as it was at its last ts_render_surface_update (or when it was
+ * added) to a VTU file for ParaView: triangles, with point data Normals and
+ * TextureCoordinates. A file that cannot be written gives TS_STATUS_IO_ERROR.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `path` is NULL or NUL-terminated.
+ */
+enum ts_status ts_render_surface_write_vtu(const struct ts_world *world,
+                                           uint32_t surface,
+                                           const char *path);
 
 #ifdef __cplusplus
 }  // extern "C"

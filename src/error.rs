@@ -16,6 +16,8 @@ pub enum Error {
     UnknownBody(u32),
     /// No tool with this id exists in the world.
     UnknownTool(u32),
+    /// No render surface with this id exists in the world.
+    UnknownRenderSurface(u32),
     /// A caller-provided buffer is too small: `needed` elements are required.
     BufferTooSmall {
         /// Number of elements the buffer must hold.
@@ -37,6 +39,7 @@ impl fmt::Display for Error {
             Error::NonFinite(m) => write!(f, "non-finite input: {m}"),
             Error::UnknownBody(id) => write!(f, "unknown body id {id}"),
             Error::UnknownTool(id) => write!(f, "unknown tool id {id}"),
+            Error::UnknownRenderSurface(id) => write!(f, "unknown render surface id {id}"),
             Error::BufferTooSmall { needed } => {
                 write!(f, "buffer too small: {needed} elements needed")
             }

@@ -6,10 +6,13 @@
 //! cargo run --release -- [--steps N] [--out DIR] [--every K] [--no-settle]
 //! ```
 //! Prints time (s), largest displacement (mm), volume ratio and ms per step as it runs, and writes
-//! `DIR/organ_XXXX.vtu` every K steps (default `out/`, every 100 steps) for ParaView.
+//! `DIR/organ_XXXX.vtu` every K steps (default `out/`, every 100 steps) for ParaView, and beside
+//! it `DIR/organ_XXXX_surface.obj`: the organ's render surface (its boundary triangles, which the
+//! default organ has instead of a visual mesh) with per-vertex normals, for a renderer.
 
 use std::path::PathBuf;
 use std::time::Instant;
+use tissuesim::render::RenderMesh;
 use tissuesim::{mesh, BodyOptions, Settings, Vec3, World};
 
 struct Args {
@@ -75,6 +78,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         Vec3::new(hi.x + 1.0, hi.y + 1.0, hi.z + 1.0),
     )?;
     let b = world.body(body)?;
+    let surface = RenderMesh::from_boundary(b.rest_positions(), b.boundary_triangles());
+    let surface = world.add_render_surface(body, surface)?;
+    let b = world.body(body)?;
     println!(
         "default organ: {} particles, {} tetrahedra, {} fixed, {:.3} kg, {:.1} cm3, size {:.0} mm",
         b.particle_count(),
@@ -135,8 +141,14 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                     ("velocity", b.velocities()),
                 ],
             )?;
+            world.update_render_surface(surface)?.write_obj(
+                &path.with_file_name(format!("organ_{:04}_surface.obj", s / args.every)),
+            )?;
         }
     }
-    println!("VTU files in {}", args.out.display());
+    println!(
+        "VTU files and render surfaces (OBJ) in {}",
+        args.out.display()
+    );
     Ok(())
 }

@@ -26,6 +26,7 @@ use crate::error::Error;
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::parallel::Pool;
+use crate::render::{RenderMesh, RenderSurface};
 use crate::settings::{ContactMode, Settings};
 use parry3d_f64::math::Point;
 
@@ -36,6 +37,10 @@ pub struct BodyId(pub u32);
 /// Identifies a tool inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ToolId(pub u32);
+
+/// Identifies a render surface inside its world (index in insertion order, never reused).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RenderSurfaceId(pub u32);
 
 /// What one step did.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -60,6 +65,7 @@ pub struct World {
     pub(crate) bodies: Vec<Body>,
     /// Tools by id; `None` for a removed tool (ids are never reused).
     pub(crate) tools: Vec<Option<Tool>>,
+    render_surfaces: Vec<RenderSurface>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
     pool: Pool,
@@ -76,6 +82,7 @@ impl World {
             settings,
             bodies: Vec::new(),
             tools: Vec::new(),
+            render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             grid: HashGrid::default(),
             time: 0.0,
@@ -177,6 +184,42 @@ impl World {
             *v = if *fixed { Vec3::zeros() } else { *given };
         }
         Ok(())
+    }
+    /// Bind a render (visual) surface to a body: every vertex gets barycentric coordinates in
+    /// the body's enclosing rest tetrahedron, or in the nearest one (extrapolated) when it lies
+    /// outside. `mesh` positions are in the body's rest frame (m), e.g. from
+    /// [`crate::render::read_obj`] with the scale of the body's mesh, or
+    /// [`RenderMesh::from_boundary`]. The surface is updated from the body's current positions
+    /// once here, then on request ([`World::update_render_surface`]); `step()` never touches it.
+    pub fn add_render_surface(
+        &mut self,
+        body: BodyId,
+        mesh: RenderMesh,
+    ) -> Result<RenderSurfaceId, Error> {
+        let surface = RenderSurface::new(body, self.body(body)?, mesh)?;
+        self.render_surfaces.push(surface);
+        Ok(RenderSurfaceId(self.render_surfaces.len() as u32 - 1))
+    }
+    /// Number of render surfaces.
+    pub fn render_surface_count(&self) -> usize {
+        self.render_surfaces.len()
+    }
+    /// A render surface by id, as of its last update.
+    pub fn render_surface(&self, id: RenderSurfaceId) -> Result<&RenderSurface, Error> {
+        self.render_surfaces
+            .get(id.0 as usize)
+            .ok_or(Error::UnknownRenderSurface(id.0))
+    }
+    /// Recompute a render surface's deformed positions (m) and normals from its body's current
+    /// particle positions, and return it. Allocates nothing; O(vertices + triangles).
+    pub fn update_render_surface(&mut self, id: RenderSurfaceId) -> Result<&RenderSurface, Error> {
+        let surface = self
+            .render_surfaces
+            .get_mut(id.0 as usize)
+            .ok_or(Error::UnknownRenderSurface(id.0))?;
+        let body = &self.bodies[surface.body().0 as usize];
+        surface.update(body.positions());
+        Ok(surface)
     }
     /// Fix the particles with the given indices (they keep their current position). Nothing is
     /// fixed if any index is out of range.

@@ -1,11 +1,13 @@
 //! DESIGN §5: no heap allocation inside `ts_world_step` after the first step, nor in the getters
-//! a haptic loop calls every step (pose in, wrench and positions out). Counted with a global
+//! a haptic loop calls every step (pose in, wrench and positions out), nor in the render
+//! surface update a render thread calls every frame. Counted with a global
 //! allocator wrapper; this test binary runs its single test alone.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ptr::{null, null_mut};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use tissuesim::ffi::body::*;
+use tissuesim::ffi::render::*;
 use tissuesim::ffi::status::ts_status;
 use tissuesim::ffi::tool::*;
 use tissuesim::ffi::world::*;
@@ -90,6 +92,17 @@ fn haptic_loop_calls_do_not_allocate_after_the_first_step() {
         ts_status::Ok
     );
     tris.resize(3 * nt, 0);
+    let mut surface = 0;
+    assert_eq!(
+        unsafe { ts_world_add_render_surface_from_boundary(w, organ, &mut surface) },
+        ts_status::Ok
+    );
+    let mut nv = 0;
+    assert_eq!(
+        unsafe { ts_render_surface_vertex_count(w, surface, &mut nv) },
+        ts_status::Ok
+    );
+    let (mut sp, mut sn) = (vec![0.0; 3 * nv], vec![0.0; 3 * nv]);
     let mut wrench = ts_wrench::default();
     let mut frame = |k: usize, pose: &mut ts_pose| {
         // 0.1 mm a step: the probe reaches the organ whatever its sag under its own weight.
@@ -106,6 +119,12 @@ fn haptic_loop_calls_do_not_allocate_after_the_first_step() {
         );
         assert_eq!(
             unsafe { ts_body_boundary_triangles(w, organ, tris.as_mut_ptr(), tris.len()) },
+            ts_status::Ok
+        );
+        assert_eq!(
+            unsafe {
+                ts_render_surface_update(w, surface, sp.as_mut_ptr(), sn.as_mut_ptr(), sp.len())
+            },
             ts_status::Ok
         );
     };

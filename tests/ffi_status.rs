@@ -232,7 +232,7 @@ fn status_strings_are_static_and_named() {
     assert!(ok.to_str().unwrap().starts_with("TS_STATUS_OK"));
     let np = unsafe { CStr::from_ptr(ts_status_string(S::NullParameter as i32)) };
     assert!(np.to_str().unwrap().starts_with("TS_STATUS_NULL_PARAMETER"));
-    for bad in [-1, 13, 9999, i32::MIN, i32::MAX] {
+    for bad in [-1, 14, 9999, i32::MIN, i32::MAX] {
         let s = unsafe { CStr::from_ptr(ts_status_string(bad)) };
         assert_eq!(s.to_str().unwrap(), "unknown ts_status value");
     }
@@ -254,6 +254,7 @@ fn status_numbers_are_stable() {
         (S::IoError, 10),
         (S::Panic, 11),
         (S::Poisoned, 12),
+        (S::UnknownRenderSurface, 13),
     ];
     for (s, n) in expected {
         assert_eq!(s as i32, n, "{s:?}");

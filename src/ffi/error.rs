@@ -38,6 +38,7 @@ pub fn status_of(e: &Error) -> ts_status {
         Error::NonFinite(_) => ts_status::NonFinite,
         Error::UnknownBody(_) => ts_status::UnknownBody,
         Error::UnknownTool(_) => ts_status::UnknownTool,
+        Error::UnknownRenderSurface(_) => ts_status::UnknownRenderSurface,
         Error::BufferTooSmall { .. } => ts_status::BufferTooSmall,
         Error::BadState(_) => ts_status::BadState,
         Error::Io(_) => ts_status::IoError,

@@ -45,6 +45,8 @@ pub mod tool;
 
 pub mod state;
 
+pub mod render;
+
 pub use body::{ts_body_options, ts_material};
 pub use status::ts_status;
 pub use tool::{ts_pose, ts_tool_options, ts_wrench};

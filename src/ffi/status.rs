@@ -35,11 +35,13 @@ pub enum ts_status {
     Panic = 11,
     /// The world is unusable because an earlier call panicked while changing it; free it.
     Poisoned = 12,
+    /// No render surface with this id exists in the world.
+    UnknownRenderSurface = 13,
 }
 
 impl ts_status {
     /// Every status, in numeric order.
-    pub(crate) const ALL: [ts_status; 13] = [
+    pub(crate) const ALL: [ts_status; 14] = [
         ts_status::Ok,
         ts_status::NullParameter,
         ts_status::InvalidArgument,
@@ -53,6 +55,7 @@ impl ts_status {
         ts_status::IoError,
         ts_status::Panic,
         ts_status::Poisoned,
+        ts_status::UnknownRenderSurface,
     ];
 
     /// The status with numeric value `code`, if there is one.
@@ -87,6 +90,9 @@ impl ts_status {
             ts_status::Panic => "TS_STATUS_PANIC: internal error (a Rust panic was caught)\0",
             ts_status::Poisoned => {
                 "TS_STATUS_POISONED: the world is unusable after an internal error\0"
+            }
+            ts_status::UnknownRenderSurface => {
+                "TS_STATUS_UNKNOWN_RENDER_SURFACE: no render surface with this id\0"
             }
         }
     }

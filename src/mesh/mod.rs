@@ -15,7 +15,7 @@ mod gmsh;
 mod lattice;
 mod obj;
 mod organ;
-mod parse;
+pub(crate) mod parse;
 mod tetgen;
 mod vtk;
 mod vtu;
@@ -154,7 +154,34 @@ pub fn write_vtu(
     point_scalars: &[(&str, &[Real])],
     point_vectors: &[(&str, &[Vec3])],
 ) -> std::io::Result<()> {
-    vtu::write_vtu(path, positions, tets, point_scalars, point_vectors)
+    vtu::write_vtu(
+        path,
+        positions,
+        tets,
+        vtu::VTK_TETRA,
+        point_scalars,
+        point_vectors,
+    )
+}
+
+/// Write a triangulated surface for ParaView as VTU (XML `UnstructuredGrid`, ASCII, cell type
+/// 5): points (m), triangles, and per-point data arrays (scalars and 3-vectors, named), e.g.
+/// the deformed render surface with its `Normals`.
+pub fn write_vtu_surface(
+    path: &Path,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    point_scalars: &[(&str, &[Real])],
+    point_vectors: &[(&str, &[Vec3])],
+) -> std::io::Result<()> {
+    vtu::write_vtu(
+        path,
+        positions,
+        triangles,
+        vtu::VTK_TRIANGLE,
+        point_scalars,
+        point_vectors,
+    )
 }
 
 /// The embedded default organ: a liver-like lobed solid about 0.2 m across, tetrahedralised

@@ -1,4 +1,5 @@
-//! VTU writer: XML `UnstructuredGrid`, ASCII, for ParaView.
+//! VTU writer: XML `UnstructuredGrid`, ASCII, for ParaView: tetrahedra (cell type 10) or
+//! triangles (cell type 5, surfaces).
 
 use crate::math::{Real, Vec3};
 use std::io::{self, Write};
@@ -24,24 +25,31 @@ fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
 
-/// Write the VTU file (see [`write_vtu`](super::write_vtu)). Inputs are checked before the
-/// file is created: every tetrahedron index must be in range and every data array must have
-/// one entry per point, else an [`io::ErrorKind::InvalidInput`] error.
-pub(crate) fn write_vtu(
+/// VTK cell type of a tetrahedron.
+pub(crate) const VTK_TETRA: u8 = 10;
+/// VTK cell type of a triangle.
+pub(crate) const VTK_TRIANGLE: u8 = 5;
+
+/// Write the VTU file (see [`write_vtu`](super::write_vtu)): cells of `K` points each, all of
+/// VTK type `cell_type`. Inputs are checked before the file is created: every cell index must
+/// be in range and every data array must have one entry per point, else an
+/// [`io::ErrorKind::InvalidInput`] error.
+pub(crate) fn write_vtu<const K: usize>(
     path: &Path,
     positions: &[Vec3],
-    tets: &[[u32; 4]],
+    cells: &[[u32; K]],
+    cell_type: u8,
     point_scalars: &[(&str, &[Real])],
     point_vectors: &[(&str, &[Vec3])],
 ) -> io::Result<()> {
     let n = positions.len();
-    if let Some((t, tet)) = tets
+    if let Some((c, cell)) = cells
         .iter()
         .enumerate()
-        .find(|(_, t)| t.iter().any(|&i| i as usize >= n))
+        .find(|(_, c)| c.iter().any(|&i| i as usize >= n))
     {
         return Err(invalid(format!(
-            "tetrahedron {t} {tet:?} references a node out of range ({n} points)"
+            "cell {c} {cell:?} references a point out of range ({n} points)"
         )));
     }
     for (name, a) in point_scalars {
@@ -72,7 +80,7 @@ pub(crate) fn write_vtu(
     writeln!(
         w,
         "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">",
-        tets.len()
+        cells.len()
     )?;
     writeln!(w, "      <PointData>")?;
     for (name, a) in point_scalars {
@@ -115,24 +123,28 @@ pub(crate) fn write_vtu(
         w,
         "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
     )?;
-    for t in tets {
-        writeln!(w, "          {} {} {} {}", t[0], t[1], t[2], t[3])?;
+    for c in cells {
+        write!(w, "         ")?;
+        for i in c {
+            write!(w, " {i}")?;
+        }
+        writeln!(w)?;
     }
     writeln!(w, "        </DataArray>")?;
     writeln!(
         w,
         "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
     )?;
-    for k in 1..=tets.len() {
-        writeln!(w, "          {}", 4 * k)?;
+    for k in 1..=cells.len() {
+        writeln!(w, "          {}", K * k)?;
     }
     writeln!(w, "        </DataArray>")?;
     writeln!(
         w,
         "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
     )?;
-    for _ in tets {
-        writeln!(w, "          10")?;
+    for _ in cells {
+        writeln!(w, "          {cell_type}")?;
     }
     writeln!(w, "        </DataArray>")?;
     writeln!(w, "      </Cells>")?;
