@@ -4,7 +4,13 @@
 //!
 //! ```text
 //! cargo run --release -p tissuesim-fmu --bin build-fmu -- [--out PATH] [--lib PATH] [--keep-debug]
+//! cargo run -p tissuesim-fmu --bin build-fmu -- --docs-table          # print the docs table
+//! cargo run -p tissuesim-fmu --bin build-fmu -- --update-docs docs/FMU.md
 //! ```
+//!
+//! `--docs-table` prints the Markdown variables table generated from the variable table (the
+//! one `modelDescription.xml` comes from); `--update-docs FILE` rewrites the table between the
+//! markers of `tissuesim_fmu::fmi2::docs` in FILE. Neither builds anything.
 //!
 //! Unless `--lib` names a library, the program first runs `cargo build --release -p
 //! tissuesim-fmu --lib` (with the `cargo` that started it, so `CARGO_TARGET_DIR` is honoured;
@@ -36,6 +42,8 @@ struct Args {
     out: Option<PathBuf>,
     lib: Option<PathBuf>,
     keep_debug: bool,
+    docs_table: bool,
+    update_docs: Option<PathBuf>,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -43,6 +51,8 @@ fn parse_args() -> Result<Args, String> {
         out: None,
         lib: None,
         keep_debug: false,
+        docs_table: false,
+        update_docs: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -50,10 +60,16 @@ fn parse_args() -> Result<Args, String> {
             "--out" => args.out = Some(it.next().ok_or("--out needs a path")?.into()),
             "--lib" => args.lib = Some(it.next().ok_or("--lib needs a path")?.into()),
             "--keep-debug" => args.keep_debug = true,
+            "--docs-table" => args.docs_table = true,
+            "--update-docs" => {
+                args.update_docs = Some(it.next().ok_or("--update-docs needs a path")?.into())
+            }
             "-h" | "--help" => {
                 println!(
                     "usage: build-fmu [--out PATH] [--lib PATH] [--keep-debug]\n\
-                     Writes TissueSim.fmu (default <target dir>/fmu/TissueSim.fmu)."
+                     \x20      build-fmu --docs-table | --update-docs FILE\n\
+                     Writes TissueSim.fmu (default <target dir>/fmu/TissueSim.fmu), or prints\n\
+                     the generated variables table, or rewrites it in FILE (docs/FMU.md)."
                 );
                 std::process::exit(0);
             }
@@ -63,8 +79,25 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-fn run() -> Result<PathBuf, String> {
+fn run() -> Result<Option<PathBuf>, String> {
     let args = parse_args()?;
+    if args.docs_table {
+        print!("{}", TissueSim::docs_table());
+        return Ok(None);
+    }
+    if let Some(path) = args.update_docs {
+        let text = fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let new = TissueSim::fmi2::docs::replace_table(&text, &TissueSim::docs_table())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        if new != text {
+            fs::write(&path, new).map_err(|e| format!("{}: {e}", path.display()))?;
+            eprintln!(
+                "build-fmu: updated the variables table of {}",
+                path.display()
+            );
+        }
+        return Ok(None);
+    }
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let exe_dir = exe.parent().ok_or("no executable directory")?.to_path_buf();
     // The program lives in <target dir>/<profile>/.
@@ -135,13 +168,15 @@ fn run() -> Result<PathBuf, String> {
     let zip = archive(&files).map_err(|e| format!("zipping {}: {e}", out.display()))?;
     fs::write(&out, zip).map_err(|e| format!("writing {}: {e}", out.display()))?;
     let _ = fs::remove_dir_all(&staging);
-    Ok(out)
+    Ok(Some(out))
 }
 
 fn main() -> ExitCode {
     match run() {
         Ok(out) => {
-            println!("{}", out.display());
+            if let Some(out) = out {
+                println!("{}", out.display());
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {
