@@ -146,6 +146,7 @@ crate::fmi2_variables! {
         GRAVITY_Y = param("gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
         GRAVITY_Z = param("gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
         THREADS = Variable::integer("threads", Parameter, Fixed, Some(1), Some(1), Some(64), "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count"),
+        SETTLE = Variable::boolean("settle", Parameter, Fixed, false, "Start at rest: at fmi2ExitInitializationMode the organ is brought to its static equilibrium under gravity (World::settle: Newton static solve, then damped relaxation; velocities zero), so the co-simulation does not start with the organ swinging into place; an organ with no fixed node cannot settle (fmi2Error)"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -211,7 +212,10 @@ impl Model for TissueSim {
     }
 
     fn initialize(&mut self, store: &mut Store, log: &Logger) -> Result<(), ModelError> {
-        let sim = build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+        let mut sim = build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+        if store.boolean(vr::SETTLE) {
+            settle(&mut sim, log)?;
+        }
         write_outputs(store, &sim, Vec3::zeros(), Vec3::zeros())?;
         self.sim = Some(sim);
         Ok(())
@@ -330,6 +334,41 @@ impl Model for TissueSim {
             t => Err(bad(format!("unknown tag {t}"))),
         }
     }
+}
+
+/// `settle = true`: bring the freshly built world to static equilibrium under gravity
+/// ([`World::settle`]); a failure is an error naming the cause.
+fn settle(sim: &mut Sim, log: &Logger) -> Result<(), ModelError> {
+    let report = sim.world.settle().map_err(|e| {
+        ModelError::error(format!(
+            "settle = true: the organ could not be brought to static equilibrium: {e}"
+        ))
+    })?;
+    let body = sim
+        .world
+        .body(sim.body)
+        .map_err(|e| ModelError::error(e.to_string()))?;
+    log.info(&format!(
+        "settled: {} Newton iterations (relative residual {:.2e}), {} relaxation steps, \
+         largest speed {:.2e} m/s{}, largest displacement {:.4} m",
+        report.newton_iterations,
+        report.relative_residual,
+        report.relaxation_steps,
+        report.max_speed,
+        if report.converged {
+            ""
+        } else {
+            " (relaxation not converged)"
+        },
+        body.max_displacement()
+    ));
+    if !report.converged {
+        log.warning(&format!(
+            "settle: relaxation stopped after {} steps with particles still moving at {:.2e} m/s",
+            report.relaxation_steps, report.max_speed
+        ));
+    }
+    Ok(())
 }
 
 /// Run `n` world steps moving the tool from `from` to `to`; the mean force and torque.
@@ -661,6 +700,7 @@ mod tests {
         for (v, id) in VARIABLES.iter().zip(vr::IDENTIFIERS) {
             assert_eq!(v.name.to_uppercase(), *id);
         }
+        assert_eq!(VARIABLES[vr::SETTLE as usize].name, "settle");
     }
 
     /// The variables table of docs/FMU.md is the one generated from [`VARIABLES`]

@@ -360,6 +360,61 @@ def test_every_corrupted_bit_is_refused_at_deserialize(slaves, vr, md):
     assert np.array_equal(reference, again)
 
 
+def first_steps(fmu, vr, n):
+    """max_displacement and volume at initialisation and after each of n steps (tool at rest,
+    out of contact); contact count and force magnitude after each step."""
+    names = ["max_displacement", "volume"]
+    rows = [list(fmu.getReal([vr[k] for k in names])) + [0, 0.0]]
+    t = 0.0
+    for _ in range(n):
+        fmu.doStep(t, H)
+        t += H
+        f = np.linalg.norm(fmu.getReal([vr[k] for k in FORCE]))
+        rows.append(list(fmu.getReal([vr[k] for k in names]))
+                    + [fmu.getInteger([vr["contact_count"]])[0], f])
+    return np.array(rows)
+
+
+def test_settle_starts_the_organ_at_rest(slaves, vr):
+    """settle = true: the organ starts in static equilibrium, so over the first 0.1 s it barely
+    moves, while without settle it falls into its sag."""
+    rec = Recorder()
+    settled = first_steps(slaves.initialised(callbacks=rec.callbacks, settle=True), vr, 10)
+    swinging = first_steps(slaves.initialised(settle=False), vr, 10)
+    drift_settled = np.abs(settled[:, 0] - settled[0, 0]).max()
+    drift_swinging = np.abs(swinging[:, 0] - swinging[0, 0]).max()
+    dvol_settled = np.abs(settled[:, 1] / settled[0, 1] - 1).max()
+    print(f"displacement change over 0.1 s: settled {drift_settled:.3e} m, "
+          f"not settled {drift_swinging:.3e} m; initial sag {settled[0, 0]:.4f} m; "
+          f"volume change settled {dvol_settled:.2e}")
+    assert settled[0, 0] > 0.005, "the settled organ starts sagged, not at its rest shape"
+    assert swinging[0, 0] == 0.0
+    assert drift_swinging > 0.005
+    assert drift_settled < 1e-4
+    assert drift_settled < 0.01 * drift_swinging
+    assert dvol_settled < 1e-3
+    # The tool stays clear: no contact, no force, in both runs.
+    assert settled[1:, 2].max() == 0 and settled[1:, 3].max() == 0.0
+    assert not any(s == 3 for s, _, _ in rec.messages)
+
+
+def test_settle_failure_is_an_error_and_can_be_corrected(slaves, vr):
+    """A body with no fixed node has no static equilibrium: fmi2ExitInitializationMode fails
+    with a logged reason, the instance stays in initialisation mode and can be corrected."""
+    rec = Recorder()
+    fmu = slaves.new(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    slaves.set(fmu, settle=True, fixed_min_y=1.0)  # empty fixed box
+    with pytest.raises(FMICallException):
+        fmu.exitInitializationMode()
+    errors = [m for s, _, m in rec.messages if s == 3]
+    assert any("fmi2ExitInitializationMode" in m and "settle" in m for m in errors), errors
+    slaves.set(fmu, fixed_min_y=0.043)
+    fmu.exitInitializationMode()
+    fmu.doStep(0.0, H)
+
+
 # --------------------------------------------------------------------------------------------
 # Several instances
 
