@@ -20,59 +20,13 @@ use crate::fmi2::{
     Variability::{Continuous, Discrete, Fixed, Tunable},
     Variable,
 };
+
 use std::path::{Path, PathBuf};
 use tissuesim::math::Quat;
 use tissuesim::{
     mesh, BodyId, BodyOptions, Error, Material, Pose, Settings, ToolId, ToolOptions, ToolShape,
     Vec3, World,
 };
-
-/// Value references, one constant per variable (value reference = index in [`VARIABLES`]).
-#[allow(missing_docs)]
-pub mod vr {
-    pub const TOOL_PX: u32 = 0;
-    pub const TOOL_PY: u32 = 1;
-    pub const TOOL_PZ: u32 = 2;
-    pub const TOOL_QW: u32 = 3;
-    pub const TOOL_QX: u32 = 4;
-    pub const TOOL_QY: u32 = 5;
-    pub const TOOL_QZ: u32 = 6;
-    pub const FORCE_X: u32 = 7;
-    pub const FORCE_Y: u32 = 8;
-    pub const FORCE_Z: u32 = 9;
-    pub const TORQUE_X: u32 = 10;
-    pub const TORQUE_Y: u32 = 11;
-    pub const TORQUE_Z: u32 = 12;
-    pub const VOLUME: u32 = 13;
-    pub const VOLUME_RATIO: u32 = 14;
-    pub const CONTACT_COUNT: u32 = 15;
-    pub const MAX_DISPLACEMENT: u32 = 16;
-    pub const MAX_PENETRATION: u32 = 17;
-    pub const YOUNGS_MODULUS: u32 = 18;
-    pub const POISSON_RATIO: u32 = 19;
-    pub const DENSITY: u32 = 20;
-    pub const DAMPING: u32 = 21;
-    pub const FRICTION_STATIC: u32 = 22;
-    pub const FRICTION_KINETIC: u32 = 23;
-    pub const TOOL_SHAPE: u32 = 24;
-    pub const TOOL_RADIUS: u32 = 25;
-    pub const TOOL_HALF_LENGTH: u32 = 26;
-    pub const INTERNAL_STEP: u32 = 27;
-    pub const VOLUME_COMPLIANCE: u32 = 28;
-    pub const VOLUME_CONSTRAINTS: u32 = 29;
-    pub const MESH: u32 = 30;
-    pub const MESH_SCALE: u32 = 31;
-    pub const FIXED_MIN_X: u32 = 32;
-    pub const FIXED_MIN_Y: u32 = 33;
-    pub const FIXED_MIN_Z: u32 = 34;
-    pub const FIXED_MAX_X: u32 = 35;
-    pub const FIXED_MAX_Y: u32 = 36;
-    pub const FIXED_MAX_Z: u32 = 37;
-    pub const GRAVITY_X: u32 = 38;
-    pub const GRAVITY_Y: u32 = 39;
-    pub const GRAVITY_Z: u32 = 40;
-    pub const THREADS: u32 = 41;
-}
 
 /// Default tool position (m): ~1.7 cm in front (+z) of the default organ's right lobe at
 /// mid-height. The organ hangs from its fixed top and sags several centimetres under gravity,
@@ -115,48 +69,15 @@ pub static TOOL_SHAPE_TYPE: EnumType = EnumType {
     ],
 };
 
-#[allow(clippy::too_many_arguments)]
-const fn real(
-    vr: u32,
-    name: &'static str,
-    causality: crate::fmi2::Causality,
-    variability: Variability,
-    unit: &'static str,
-    start: Option<f64>,
-    min: Option<f64>,
-    description: &'static str,
-) -> Variable {
-    Variable {
-        name,
-        vr,
-        causality,
-        variability,
-        kind: Kind::Real {
-            unit,
-            start,
-            min,
-            max: None,
-        },
-        description,
-    }
+const fn input(name: &'static str, unit: &'static str, start: f64, d: &'static str) -> Variable {
+    Variable::real(name, Input, Continuous, unit, Some(start), None, None, d)
 }
 
-const fn input(
-    vr: u32,
-    name: &'static str,
-    unit: &'static str,
-    start: f64,
-    d: &'static str,
-) -> Variable {
-    real(vr, name, Input, Continuous, unit, Some(start), None, d)
-}
-
-const fn output(vr: u32, name: &'static str, unit: &'static str, d: &'static str) -> Variable {
-    real(vr, name, Output, Continuous, unit, None, None, d)
+const fn output(name: &'static str, unit: &'static str, d: &'static str) -> Variable {
+    Variable::real(name, Output, Continuous, unit, None, None, None, d)
 }
 
 const fn param(
-    vr: u32,
     name: &'static str,
     variability: Variability,
     unit: &'static str,
@@ -164,113 +85,70 @@ const fn param(
     min: Option<f64>,
     d: &'static str,
 ) -> Variable {
-    real(vr, name, Parameter, variability, unit, Some(start), min, d)
+    Variable::real(
+        name,
+        Parameter,
+        variability,
+        unit,
+        Some(start),
+        min,
+        None,
+        d,
+    )
 }
 
-/// The variable table (value reference = index).
-pub static VARIABLES: &[Variable] = &[
-    input(vr::TOOL_PX, "tool_px", "m", DEFAULT_TOOL_POSITION[0], "Tool origin position x (world frame)"),
-    input(vr::TOOL_PY, "tool_py", "m", DEFAULT_TOOL_POSITION[1], "Tool origin position y (world frame, y up)"),
-    input(vr::TOOL_PZ, "tool_pz", "m", DEFAULT_TOOL_POSITION[2], "Tool origin position z (world frame)"),
-    input(vr::TOOL_QW, "tool_qw", "", 1.0, "Tool orientation quaternion w (local to world; normalised on use, must not be zero)"),
-    input(vr::TOOL_QX, "tool_qx", "", 0.0, "Tool orientation quaternion x"),
-    input(vr::TOOL_QY, "tool_qy", "", 0.0, "Tool orientation quaternion y"),
-    input(vr::TOOL_QZ, "tool_qz", "", 0.0, "Tool orientation quaternion z"),
-    output(vr::FORCE_X, "force_x", "N", "Force exerted by the tissue on the tool, x (world frame, averaged over the communication step)"),
-    output(vr::FORCE_Y, "force_y", "N", "Force exerted by the tissue on the tool, y"),
-    output(vr::FORCE_Z, "force_z", "N", "Force exerted by the tissue on the tool, z"),
-    output(vr::TORQUE_X, "torque_x", "N.m", "Torque exerted by the tissue on the tool about its origin, x (world frame, averaged over the communication step)"),
-    output(vr::TORQUE_Y, "torque_y", "N.m", "Torque on the tool about its origin, y"),
-    output(vr::TORQUE_Z, "torque_z", "N.m", "Torque on the tool about its origin, z"),
-    output(vr::VOLUME, "volume", "m3", "Current organ volume (sum of signed tetrahedron volumes) at the end of the step"),
-    output(vr::VOLUME_RATIO, "volume_ratio", "", "Organ volume / rest volume at the end of the step"),
-    Variable {
-        name: "contact_count",
-        vr: vr::CONTACT_COUNT,
-        causality: Output,
-        variability: Discrete,
-        kind: Kind::Integer {
-            start: None,
-            min: Some(0),
-            max: None,
-        },
-        description: "Number of organ particles in contact with the tool at the end of the step",
-    },
-    output(vr::MAX_DISPLACEMENT, "max_displacement", "m", "Largest distance of an organ particle from its rest position at the end of the step"),
-    output(vr::MAX_PENETRATION, "max_penetration", "m", "Largest penetration of a particle into the tool before projection, last internal step"),
-    param(vr::YOUNGS_MODULUS, "youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
-    Variable {
-        name: "poisson_ratio",
-        vr: vr::POISSON_RATIO,
-        causality: Parameter,
-        variability: Fixed,
-        kind: Kind::Real {
-            unit: "",
-            start: Some(0.45),
-            min: Some(tissuesim::body::MIN_POISSON_RATIO),
-            max: Some(tissuesim::body::MAX_POISSON_RATIO),
-        },
-        description: "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)",
-    },
-    param(vr::DENSITY, "density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
-    param(vr::DAMPING, "damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
-    param(vr::FRICTION_STATIC, "friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),
-    param(vr::FRICTION_KINETIC, "friction_kinetic", Fixed, "", 0.1, Some(0.0), "Kinetic friction coefficient between tool and tissue (<= friction_static)"),
-    Variable {
-        name: "tool_shape",
-        vr: vr::TOOL_SHAPE,
-        causality: Parameter,
-        variability: Fixed,
-        kind: Kind::Enumeration {
-            ty: &TOOL_SHAPE_TYPE,
-            start: 0,
-        },
-        description: "Tool shape: 0 sphere, 1 capsule, 2 cylinder, 3 box",
-    },
-    param(vr::TOOL_RADIUS, "tool_radius", Fixed, "m", 0.01, Some(0.0), "Tool radius (sphere, capsule, cylinder) or half width (box)"),
-    param(vr::TOOL_HALF_LENGTH, "tool_half_length", Fixed, "m", 0.03, Some(0.0), "Half length of a capsule, cylinder or box along the tool's local y axis"),
-    param(vr::INTERNAL_STEP, "internal_step", Tunable, "s", 1.0e-3, Some(0.0), "Largest internal time step: fmi2DoStep(h) runs ceil(h/internal_step) world steps of equal length"),
-    param(vr::VOLUME_COMPLIANCE, "volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Extra compliance of the per-tetrahedron volume constraints, added to the material's 1/lambda; 0 = the material's own compressibility"),
-    Variable {
-        name: "volume_constraints",
-        vr: vr::VOLUME_CONSTRAINTS,
-        causality: Parameter,
-        variability: Tunable,
-        kind: Kind::Boolean { start: true },
-        description: "Enable the per-tetrahedron volume constraints",
-    },
-    Variable {
-        name: "mesh",
-        vr: vr::MESH,
-        causality: Parameter,
-        variability: Fixed,
-        kind: Kind::String { start: DEFAULT_MESH },
-        description: "Organ mesh: a file in the FMU's resources/ or an absolute path (.msh, .node/.ele, .vtk); empty = the embedded default organ",
-    },
-    param(vr::MESH_SCALE, "mesh_scale", Fixed, "", 1.0, Some(0.0), "Factor from mesh units to metres"),
-    param(vr::FIXED_MIN_X, "fixed_min_x", Fixed, "m", DEFAULT_FIXED_MIN[0], None, "Lower corner x of the box whose nodes are fixed (empty box: none)"),
-    param(vr::FIXED_MIN_Y, "fixed_min_y", Fixed, "m", DEFAULT_FIXED_MIN[1], None, "Lower corner y of the fixed box"),
-    param(vr::FIXED_MIN_Z, "fixed_min_z", Fixed, "m", DEFAULT_FIXED_MIN[2], None, "Lower corner z of the fixed box"),
-    param(vr::FIXED_MAX_X, "fixed_max_x", Fixed, "m", DEFAULT_FIXED_MAX[0], None, "Upper corner x of the fixed box"),
-    param(vr::FIXED_MAX_Y, "fixed_max_y", Fixed, "m", DEFAULT_FIXED_MAX[1], None, "Upper corner y of the fixed box"),
-    param(vr::FIXED_MAX_Z, "fixed_max_z", Fixed, "m", DEFAULT_FIXED_MAX[2], None, "Upper corner z of the fixed box"),
-    param(vr::GRAVITY_X, "gravity_x", Tunable, "m/s2", 0.0, None, "Gravity acceleration x"),
-    param(vr::GRAVITY_Y, "gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
-    param(vr::GRAVITY_Z, "gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
-    Variable {
-        name: "threads",
-        vr: vr::THREADS,
-        causality: Parameter,
-        variability: Fixed,
-        kind: Kind::Integer {
-            start: Some(1),
-            min: Some(1),
-            max: Some(64),
-        },
-        description: "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count",
-    },
-];
-
+crate::fmi2_variables! {
+    /// Value references, one constant per variable (value reference = row of [`VARIABLES`]).
+    pub mod vr;
+    /// The variable table: the single declaration of every variable, from which
+    /// `modelDescription.xml`, the [`vr`] constants and the variables table of `docs/FMU.md`
+    /// are generated.
+    pub static VARIABLES = [
+        TOOL_PX = input("tool_px", "m", DEFAULT_TOOL_POSITION[0], "Tool origin position x (world frame)"),
+        TOOL_PY = input("tool_py", "m", DEFAULT_TOOL_POSITION[1], "Tool origin position y (world frame, y up)"),
+        TOOL_PZ = input("tool_pz", "m", DEFAULT_TOOL_POSITION[2], "Tool origin position z (world frame)"),
+        TOOL_QW = input("tool_qw", "", 1.0, "Tool orientation quaternion w (local to world; normalised on use, must not be zero)"),
+        TOOL_QX = input("tool_qx", "", 0.0, "Tool orientation quaternion x"),
+        TOOL_QY = input("tool_qy", "", 0.0, "Tool orientation quaternion y"),
+        TOOL_QZ = input("tool_qz", "", 0.0, "Tool orientation quaternion z"),
+        FORCE_X = output("force_x", "N", "Force exerted by the tissue on the tool, x (world frame, averaged over the communication step)"),
+        FORCE_Y = output("force_y", "N", "Force exerted by the tissue on the tool, y"),
+        FORCE_Z = output("force_z", "N", "Force exerted by the tissue on the tool, z"),
+        TORQUE_X = output("torque_x", "N.m", "Torque exerted by the tissue on the tool about its origin, x (world frame, averaged over the communication step)"),
+        TORQUE_Y = output("torque_y", "N.m", "Torque on the tool about its origin, y"),
+        TORQUE_Z = output("torque_z", "N.m", "Torque on the tool about its origin, z"),
+        VOLUME = output("volume", "m3", "Current organ volume (sum of signed tetrahedron volumes) at the end of the step"),
+        VOLUME_RATIO = output("volume_ratio", "", "Organ volume / rest volume at the end of the step"),
+        CONTACT_COUNT = Variable::integer("contact_count", Output, Discrete, None, Some(0), None, "Number of organ particles in contact with the tool at the end of the step"),
+        MAX_DISPLACEMENT = output("max_displacement", "m", "Largest distance of an organ particle from its rest position at the end of the step"),
+        MAX_PENETRATION = output("max_penetration", "m", "Largest penetration of a particle into the tool before projection, last internal step"),
+        YOUNGS_MODULUS = param("youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
+        POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::body::MIN_POISSON_RATIO), Some(tissuesim::body::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
+        DENSITY = param("density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
+        DAMPING = param("damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
+        FRICTION_STATIC = param("friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),
+        FRICTION_KINETIC = param("friction_kinetic", Fixed, "", 0.1, Some(0.0), "Kinetic friction coefficient between tool and tissue (<= friction_static)"),
+        TOOL_SHAPE = Variable::enumeration("tool_shape", Parameter, Fixed, &TOOL_SHAPE_TYPE, 0, "Tool shape: 0 sphere, 1 capsule, 2 cylinder, 3 box"),
+        TOOL_RADIUS = param("tool_radius", Fixed, "m", 0.01, Some(0.0), "Tool radius (sphere, capsule, cylinder) or half width (box)"),
+        TOOL_HALF_LENGTH = param("tool_half_length", Fixed, "m", 0.03, Some(0.0), "Half length of a capsule, cylinder or box along the tool's local y axis"),
+        INTERNAL_STEP = param("internal_step", Tunable, "s", 1.0e-3, Some(0.0), "Largest internal time step: fmi2DoStep(h) runs ceil(h/internal_step) world steps of equal length"),
+        VOLUME_COMPLIANCE = param("volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Extra compliance of the per-tetrahedron volume constraints, added to the material's 1/lambda; 0 = the material's own compressibility"),
+        VOLUME_CONSTRAINTS = Variable::boolean("volume_constraints", Parameter, Tunable, true, "Enable the per-tetrahedron volume constraints"),
+        MESH = Variable::string("mesh", Parameter, Fixed, DEFAULT_MESH, "Organ mesh: a file in the FMU's resources/ or an absolute path (.msh, .node/.ele, .vtk); empty = the embedded default organ"),
+        MESH_SCALE = param("mesh_scale", Fixed, "", 1.0, Some(0.0), "Factor from mesh units to metres"),
+        FIXED_MIN_X = param("fixed_min_x", Fixed, "m", DEFAULT_FIXED_MIN[0], None, "Lower corner x of the box whose nodes are fixed (empty box: none)"),
+        FIXED_MIN_Y = param("fixed_min_y", Fixed, "m", DEFAULT_FIXED_MIN[1], None, "Lower corner y of the fixed box"),
+        FIXED_MIN_Z = param("fixed_min_z", Fixed, "m", DEFAULT_FIXED_MIN[2], None, "Lower corner z of the fixed box"),
+        FIXED_MAX_X = param("fixed_max_x", Fixed, "m", DEFAULT_FIXED_MAX[0], None, "Upper corner x of the fixed box"),
+        FIXED_MAX_Y = param("fixed_max_y", Fixed, "m", DEFAULT_FIXED_MAX[1], None, "Upper corner y of the fixed box"),
+        FIXED_MAX_Z = param("fixed_max_z", Fixed, "m", DEFAULT_FIXED_MAX[2], None, "Upper corner z of the fixed box"),
+        GRAVITY_X = param("gravity_x", Tunable, "m/s2", 0.0, None, "Gravity acceleration x"),
+        GRAVITY_Y = param("gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
+        GRAVITY_Z = param("gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
+        THREADS = Variable::integer("threads", Parameter, Fixed, Some(1), Some(1), Some(64), "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count"),
+        SETTLE = Variable::boolean("settle", Parameter, Fixed, false, "Start at rest: at fmi2ExitInitializationMode the organ is brought to its static equilibrium under gravity (World::settle: Newton static solve, then damped relaxation; velocities zero), so the co-simulation does not start with the organ swinging into place; an organ with no fixed node cannot settle (fmi2Error)"),
+    ];
+}
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
     UnitDefinition { name, kg, m, s }
 }
@@ -323,6 +201,7 @@ impl Model for TissueSim {
         stop_time: 1.0,
         step_size: 1.0e-3,
     };
+    const STATE_MAGIC: [u8; 8] = *b"TSFMUST\0";
 
     fn new(resources: Option<PathBuf>) -> Self {
         TissueSim {
@@ -333,7 +212,10 @@ impl Model for TissueSim {
     }
 
     fn initialize(&mut self, store: &mut Store, log: &Logger) -> Result<(), ModelError> {
-        let sim = build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+        let mut sim = build(store, self.resources.as_deref(), log).map_err(ModelError::error)?;
+        if store.boolean(vr::SETTLE) {
+            settle(&mut sim, log)?;
+        }
         write_outputs(store, &sim, Vec3::zeros(), Vec3::zeros())?;
         self.sim = Some(sim);
         Ok(())
@@ -452,6 +334,41 @@ impl Model for TissueSim {
             t => Err(bad(format!("unknown tag {t}"))),
         }
     }
+}
+
+/// `settle = true`: bring the freshly built world to static equilibrium under gravity
+/// ([`World::settle`]); a failure is an error naming the cause.
+fn settle(sim: &mut Sim, log: &Logger) -> Result<(), ModelError> {
+    let report = sim.world.settle().map_err(|e| {
+        ModelError::error(format!(
+            "settle = true: the organ could not be brought to static equilibrium: {e}"
+        ))
+    })?;
+    let body = sim
+        .world
+        .body(sim.body)
+        .map_err(|e| ModelError::error(e.to_string()))?;
+    log.info(&format!(
+        "settled: {} Newton iterations (relative residual {:.2e}), {} relaxation steps, \
+         largest speed {:.2e} m/s{}, largest displacement {:.4} m",
+        report.newton_iterations,
+        report.relative_residual,
+        report.relaxation_steps,
+        report.max_speed,
+        if report.converged {
+            ""
+        } else {
+            " (relaxation not converged)"
+        },
+        body.max_displacement()
+    ));
+    if !report.converged {
+        log.warning(&format!(
+            "settle: relaxation stopped after {} steps with particles still moving at {:.2e} m/s",
+            report.relaxation_steps, report.max_speed
+        ));
+    }
+    Ok(())
 }
 
 /// Run `n` world steps moving the tool from `from` to `to`; the mean force and torque.
@@ -778,22 +695,26 @@ mod tests {
     #[test]
     fn table_is_consistent() {
         check_table(VARIABLES, UNITS).unwrap();
-        assert_eq!(VARIABLES.len(), vr::THREADS as usize + 1);
+        assert_eq!(VARIABLES.len(), vr::IDENTIFIERS.len());
+        // The value-reference constants are the variable names in upper case.
+        for (v, id) in VARIABLES.iter().zip(vr::IDENTIFIERS) {
+            assert_eq!(v.name.to_uppercase(), *id);
+        }
+        assert_eq!(VARIABLES[vr::SETTLE as usize].name, "settle");
     }
 
-    /// docs/FMU.md documents every variable, in table order.
+    /// The variables table of docs/FMU.md is the one generated from [`VARIABLES`]
+    /// (regenerate it with `build-fmu --update-docs docs/FMU.md`).
     #[test]
-    fn docs_list_every_variable() {
+    fn docs_table_is_generated_from_the_variables() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/FMU.md");
         let docs = std::fs::read_to_string(&path).unwrap();
-        let mut from = 0;
-        for v in VARIABLES {
-            let row = format!("| `{}` | {} |", v.name, v.vr);
-            let at = docs[from..]
-                .find(&row)
-                .unwrap_or_else(|| panic!("{} does not document {row}", path.display()));
-            from += at;
-        }
+        let expected = crate::fmi2::docs::replace_table(&docs, &crate::docs_table()).unwrap();
+        assert!(
+            docs == expected,
+            "{} has a stale variables table: run `cargo run -p tissuesim-fmu --bin build-fmu -- --update-docs docs/FMU.md`",
+            path.display()
+        );
     }
 
     #[test]

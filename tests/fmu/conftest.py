@@ -55,6 +55,14 @@ def vr(md):
     return {v.name: v.valueReference for v in md.modelVariables}
 
 
+# Every Recorder ever made, kept alive for the whole session: fmpy's native logger proxy keeps
+# the Python logger of the last `addLoggerProxy` call in a global and calls it for every
+# proxied callback struct (fmpy's default callbacks included), so a recorder's ctypes callback
+# freed by the garbage collector would later be called from C (a segmentation fault whose
+# timing depends on when the collector runs).
+_RECORDERS = []
+
+
 class Recorder:
     """fmi2CallbackFunctions whose logger records (status, category, message).
 
@@ -63,6 +71,7 @@ class Recorder:
     """
 
     def __init__(self, proxy=True):
+        _RECORDERS.append(self)
         self.messages = []
 
         def logger(env, name, status, category, message):

@@ -4,6 +4,8 @@ argument checks, logging and resource locations."""
 import ctypes
 import math
 import pathlib
+import random
+import struct
 import shutil
 import subprocess
 import sys
@@ -272,6 +274,145 @@ def test_corrupt_serialized_state_is_refused(slaves, vr):
     data[0] ^= 0xFF
     with pytest.raises(FMICallException):
         a.deSerializeFMUstate(bytes(data))
+
+
+def state_sections(data, md):
+    """Byte ranges [start, end) of the sections of a serialised state (format version 2, see
+    docs/FMU.md): header, variable values (parameters, inputs, outputs), model (world) state and
+    the trailing checksum; and where each variable's value lies."""
+    pos = 8 + 4
+    (glen,) = struct.unpack_from("<Q", data, pos)
+    pos += 8 + glen + 1 + 8 + 8 + 1 + 8 + 1
+    (n,) = struct.unpack_from("<I", data, pos)
+    pos += 4
+    header = (0, pos)
+    names = [v.name for v in sorted(md.modelVariables, key=lambda v: v.valueReference)]
+    assert n == len(names)
+    values = {}
+    for name in names:
+        tag = data[pos]
+        size = {0: 8, 1: 4, 2: 1}.get(tag)
+        if size is None:
+            (slen,) = struct.unpack_from("<Q", data, pos + 1)
+            size = 8 + slen
+        values[name] = (pos, pos + 1 + size)
+        pos += 1 + size
+    sections = {
+        "header": header,
+        "variables": (header[1], pos),
+        "model": (pos, len(data) - 8),
+        "checksum": (len(data) - 8, len(data)),
+    }
+    return sections, values
+
+
+def test_every_corrupted_bit_is_refused_at_deserialize(slaves, vr, md):
+    """Single-bit flips anywhere in a serialised state (every bit of the header, of the variable
+    section with the parameters and of the checksum; a seeded sample of the world state) are
+    refused by fmi2DeSerializeFMUstate with fmi2Error and a logged message; the instance keeps
+    working and the good state still restores."""
+    rec = Recorder()
+    fmu = slaves.initialised(callbacks=rec.callbacks)
+    _, t = run(fmu, vr, 0.0, 40)
+    state = fmu.getFMUState()
+    data = fmu.serializeFMUState(state)
+    fmu.freeFMUState(state)
+    assert struct.unpack_from("<I", data, 8)[0] == 2, "format version"
+    reference, _ = run(fmu, vr, t, 5)
+    good = fmu.deSerializeFMUstate(data)
+
+    sections, values = state_sections(data, md)
+    bits = []
+    for name in ("header", "variables", "checksum"):
+        lo, hi = sections[name]
+        bits += range(8 * lo, 8 * hi)
+    lo, hi = sections["model"]
+    assert hi - lo > 1000, "the world state is in the model section"
+    bits += random.Random(20240611).sample(range(8 * lo, 8 * hi), 400)
+    # The parameter section is covered, in particular the fixed box (a flip there once
+    # restored an organ without its fixed region).
+    lo, hi = values["fixed_min_y"]
+    assert all(b in bits for b in range(8 * lo, 8 * hi))
+    assert len(bits) >= 200
+
+    corrupt = bytearray(data)
+    refused = 0
+    for k, bit in enumerate(bits):
+        corrupt[bit // 8] ^= 1 << (bit % 8)
+        before = len(rec.messages)
+        with pytest.raises(FMICallException):
+            # Every other call reuses the good state: a refused call must leave it intact.
+            fmu.deSerializeFMUstate(bytes(corrupt), state=good if k % 2 else None)
+        new = rec.messages[before:]
+        assert new and new[-1][0] == 3 and "fmi2DeSerializeFMUstate" in new[-1][2], (bit, new)
+        if bit >= 8 * 12:  # after magic and version: the checksum catches it
+            assert "corrupt" in new[-1][2], (bit, new)
+        corrupt[bit // 8] ^= 1 << (bit % 8)
+        refused += 1
+    assert refused == len(bits) and bytes(corrupt) == data
+
+    # The instance still steps, and the good state (reused above) restores exactly.
+    fmu.setReal([vr["tool_pz"]], [press_z(t + 5 * H)])
+    fmu.doStep(t + 5 * H, H)
+    fmu.setFMUState(good)
+    again, _ = run(fmu, vr, t, 5)
+    fmu.freeFMUState(good)
+    assert np.array_equal(reference, again)
+
+
+def first_steps(fmu, vr, n):
+    """max_displacement and volume at initialisation and after each of n steps (tool at rest,
+    out of contact); contact count and force magnitude after each step."""
+    names = ["max_displacement", "volume"]
+    rows = [list(fmu.getReal([vr[k] for k in names])) + [0, 0.0]]
+    t = 0.0
+    for _ in range(n):
+        fmu.doStep(t, H)
+        t += H
+        f = np.linalg.norm(fmu.getReal([vr[k] for k in FORCE]))
+        rows.append(list(fmu.getReal([vr[k] for k in names]))
+                    + [fmu.getInteger([vr["contact_count"]])[0], f])
+    return np.array(rows)
+
+
+def test_settle_starts_the_organ_at_rest(slaves, vr):
+    """settle = true: the organ starts in static equilibrium, so over the first 0.1 s it barely
+    moves, while without settle it falls into its sag."""
+    rec = Recorder()
+    settled = first_steps(slaves.initialised(callbacks=rec.callbacks, settle=True), vr, 10)
+    swinging = first_steps(slaves.initialised(settle=False), vr, 10)
+    drift_settled = np.abs(settled[:, 0] - settled[0, 0]).max()
+    drift_swinging = np.abs(swinging[:, 0] - swinging[0, 0]).max()
+    dvol_settled = np.abs(settled[:, 1] / settled[0, 1] - 1).max()
+    print(f"displacement change over 0.1 s: settled {drift_settled:.3e} m, "
+          f"not settled {drift_swinging:.3e} m; initial sag {settled[0, 0]:.4f} m; "
+          f"volume change settled {dvol_settled:.2e}")
+    assert settled[0, 0] > 0.005, "the settled organ starts sagged, not at its rest shape"
+    assert swinging[0, 0] == 0.0
+    assert drift_swinging > 0.005
+    assert drift_settled < 1e-4
+    assert drift_settled < 0.01 * drift_swinging
+    assert dvol_settled < 1e-3
+    # The tool stays clear: no contact, no force, in both runs.
+    assert settled[1:, 2].max() == 0 and settled[1:, 3].max() == 0.0
+    assert not any(s == 3 for s, _, _ in rec.messages)
+
+
+def test_settle_failure_is_an_error_and_can_be_corrected(slaves, vr):
+    """A body with no fixed node has no static equilibrium: fmi2ExitInitializationMode fails
+    with a logged reason, the instance stays in initialisation mode and can be corrected."""
+    rec = Recorder()
+    fmu = slaves.new(callbacks=rec.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    slaves.set(fmu, settle=True, fixed_min_y=1.0)  # empty fixed box
+    with pytest.raises(FMICallException):
+        fmu.exitInitializationMode()
+    errors = [m for s, _, m in rec.messages if s == 3]
+    assert any("fmi2ExitInitializationMode" in m and "settle" in m for m in errors), errors
+    slaves.set(fmu, fixed_min_y=0.043)
+    fmu.exitInitializationMode()
+    fmu.doStep(0.0, H)
 
 
 # --------------------------------------------------------------------------------------------

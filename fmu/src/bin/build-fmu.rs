@@ -4,12 +4,19 @@
 //!
 //! ```text
 //! cargo run --release -p tissuesim-fmu --bin build-fmu -- [--out PATH] [--lib PATH] [--keep-debug]
+//! cargo run -p tissuesim-fmu --bin build-fmu -- --docs-table          # print the docs table
+//! cargo run -p tissuesim-fmu --bin build-fmu -- --update-docs docs/FMU.md
 //! ```
+//!
+//! `--docs-table` prints the Markdown variables table generated from the variable table (the
+//! one `modelDescription.xml` comes from); `--update-docs FILE` rewrites the table between the
+//! markers of `tissuesim_fmu::fmi2::docs` in FILE. Neither builds anything.
 //!
 //! Unless `--lib` names a library, the program first runs `cargo build --release -p
 //! tissuesim-fmu --lib` (with the `cargo` that started it, so `CARGO_TARGET_DIR` is honoured;
 //! `cargo run` alone does not copy a cdylib to `target/release/`) and packages
-//! `<target dir>/release/libTissueSim.so`. The default output is
+//! `<target dir>/release/libTissueSim.so`. The archive is written with the `zip` crate
+//! (deflated entries, fixed timestamps). The default output is
 //! `<target dir>/fmu/TissueSim.fmu`. Debug info is stripped from the packaged copy with
 //! `strip --strip-debug` when that tool exists (`--keep-debug` keeps it).
 
@@ -35,6 +42,8 @@ struct Args {
     out: Option<PathBuf>,
     lib: Option<PathBuf>,
     keep_debug: bool,
+    docs_table: bool,
+    update_docs: Option<PathBuf>,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -42,6 +51,8 @@ fn parse_args() -> Result<Args, String> {
         out: None,
         lib: None,
         keep_debug: false,
+        docs_table: false,
+        update_docs: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -49,10 +60,16 @@ fn parse_args() -> Result<Args, String> {
             "--out" => args.out = Some(it.next().ok_or("--out needs a path")?.into()),
             "--lib" => args.lib = Some(it.next().ok_or("--lib needs a path")?.into()),
             "--keep-debug" => args.keep_debug = true,
+            "--docs-table" => args.docs_table = true,
+            "--update-docs" => {
+                args.update_docs = Some(it.next().ok_or("--update-docs needs a path")?.into())
+            }
             "-h" | "--help" => {
                 println!(
                     "usage: build-fmu [--out PATH] [--lib PATH] [--keep-debug]\n\
-                     Writes TissueSim.fmu (default <target dir>/fmu/TissueSim.fmu)."
+                     \x20      build-fmu --docs-table | --update-docs FILE\n\
+                     Writes TissueSim.fmu (default <target dir>/fmu/TissueSim.fmu), or prints\n\
+                     the generated variables table, or rewrites it in FILE (docs/FMU.md)."
                 );
                 std::process::exit(0);
             }
@@ -62,8 +79,25 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-fn run() -> Result<PathBuf, String> {
+fn run() -> Result<Option<PathBuf>, String> {
     let args = parse_args()?;
+    if args.docs_table {
+        print!("{}", TissueSim::docs_table());
+        return Ok(None);
+    }
+    if let Some(path) = args.update_docs {
+        let text = fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let new = TissueSim::fmi2::docs::replace_table(&text, &TissueSim::docs_table())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        if new != text {
+            fs::write(&path, new).map_err(|e| format!("{}: {e}", path.display()))?;
+            eprintln!(
+                "build-fmu: updated the variables table of {}",
+                path.display()
+            );
+        }
+        return Ok(None);
+    }
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let exe_dir = exe.parent().ok_or("no executable directory")?.to_path_buf();
     // The program lives in <target dir>/<profile>/.
@@ -131,16 +165,18 @@ fn run() -> Result<PathBuf, String> {
     if let Some(dir) = out.parent() {
         fs::create_dir_all(dir).map_err(|e| e.to_string())?;
     }
-    let zip = zip::store(&files);
+    let zip = archive(&files).map_err(|e| format!("zipping {}: {e}", out.display()))?;
     fs::write(&out, zip).map_err(|e| format!("writing {}: {e}", out.display()))?;
     let _ = fs::remove_dir_all(&staging);
-    Ok(out)
+    Ok(Some(out))
 }
 
 fn main() -> ExitCode {
     match run() {
         Ok(out) => {
-            println!("{}", out.display());
+            if let Some(out) = out {
+                println!("{}", out.display());
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -150,100 +186,52 @@ fn main() -> ExitCode {
     }
 }
 
-/// A minimal ZIP writer: stored (uncompressed) entries, fixed timestamps (reproducible).
-mod zip {
-    fn crc32(data: &[u8]) -> u32 {
-        let mut table = [0u32; 256];
-        for (i, t) in table.iter_mut().enumerate() {
-            let mut c = i as u32;
-            for _ in 0..8 {
-                c = if c & 1 != 0 {
-                    0xEDB8_8320 ^ (c >> 1)
-                } else {
-                    c >> 1
-                };
-            }
-            *t = c;
-        }
-        !data.iter().fold(!0u32, |c, &b| {
-            table[((c ^ b as u32) & 0xff) as usize] ^ (c >> 8)
-        })
+/// The bytes of a ZIP archive holding `files` (name, content): deflated, with the fixed
+/// timestamp 1980-01-01 00:00 (reproducible archives) and Unix modes (0755 for the shared
+/// library, 0644 otherwise).
+fn archive(files: &[(String, Vec<u8>)]) -> zip::result::ZipResult<Vec<u8>> {
+    use std::io::Write;
+    use zip::write::SimpleFileOptions;
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (name, data) in files {
+        let mode = if name.starts_with("binaries/") {
+            0o755
+        } else {
+            0o644
+        };
+        let options = SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .last_modified_time(zip::DateTime::default())
+            .unix_permissions(mode);
+        zip.start_file(name.as_str(), options)?;
+        zip.write_all(data)?;
     }
+    Ok(zip.finish()?.into_inner())
+}
 
-    fn u16le(v: &mut Vec<u8>, x: u16) {
-        v.extend_from_slice(&x.to_le_bytes());
-    }
-    fn u32le(v: &mut Vec<u8>, x: u32) {
-        v.extend_from_slice(&x.to_le_bytes());
-    }
+#[cfg(test)]
+mod tests {
+    use std::io::Read;
 
-    /// The bytes of a ZIP archive holding `files` (name, content), stored.
-    pub fn store(files: &[(String, Vec<u8>)]) -> Vec<u8> {
-        const DOS_TIME: u16 = 0;
-        const DOS_DATE: u16 = (1 << 5) | 1; // 1980-01-01
-        let mut out = Vec::new();
-        let mut central = Vec::new();
-        for (name, data) in files {
-            let crc = crc32(data);
-            let offset = out.len() as u32;
-            let size = data.len() as u32;
-            u32le(&mut out, 0x0403_4b50);
-            u16le(&mut out, 20); // version needed
-            u16le(&mut out, 0x0800); // flags: UTF-8 names
-            u16le(&mut out, 0); // stored
-            u16le(&mut out, DOS_TIME);
-            u16le(&mut out, DOS_DATE);
-            u32le(&mut out, crc);
-            u32le(&mut out, size);
-            u32le(&mut out, size);
-            u16le(&mut out, name.len() as u16);
-            u16le(&mut out, 0);
-            out.extend_from_slice(name.as_bytes());
-            out.extend_from_slice(data);
-
-            u32le(&mut central, 0x0201_4b50);
-            u16le(&mut central, (3 << 8) | 20); // made by: Unix, 2.0
-            u16le(&mut central, 20);
-            u16le(&mut central, 0x0800);
-            u16le(&mut central, 0);
-            u16le(&mut central, DOS_TIME);
-            u16le(&mut central, DOS_DATE);
-            u32le(&mut central, crc);
-            u32le(&mut central, size);
-            u32le(&mut central, size);
-            u16le(&mut central, name.len() as u16);
-            u16le(&mut central, 0); // extra
-            u16le(&mut central, 0); // comment
-            u16le(&mut central, 0); // disk
-            u16le(&mut central, 0); // internal attributes
-            let mode: u32 = if name.ends_with(".so") {
-                0o100755
-            } else {
-                0o100644
-            };
-            u32le(&mut central, mode << 16);
-            u32le(&mut central, offset);
-            central.extend_from_slice(name.as_bytes());
-        }
-        let cd_offset = out.len() as u32;
-        let cd_size = central.len() as u32;
-        out.extend_from_slice(&central);
-        u32le(&mut out, 0x0605_4b50);
-        u16le(&mut out, 0);
-        u16le(&mut out, 0);
-        u16le(&mut out, files.len() as u16);
-        u16le(&mut out, files.len() as u16);
-        u32le(&mut out, cd_size);
-        u32le(&mut out, cd_offset);
-        u16le(&mut out, 0);
-        out
-    }
-
-    #[cfg(test)]
-    mod tests {
-        #[test]
-        fn crc_of_known_string() {
-            assert_eq!(super::crc32(b"123456789"), 0xCBF4_3926);
+    /// The archive reads back (names, contents, modes) and is byte-for-byte reproducible.
+    #[test]
+    fn archive_round_trip() {
+        let files = vec![
+            ("modelDescription.xml".to_string(), b"<xml/>".repeat(100)),
+            ("binaries/linux64/M.so".to_string(), vec![0u8, 1, 2, 255]),
+            ("resources/empty.txt".to_string(), Vec::new()),
+        ];
+        let bytes = super::archive(&files).unwrap();
+        assert_eq!(bytes, super::archive(&files).unwrap());
+        let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).unwrap();
+        assert_eq!(zip.len(), files.len());
+        for (name, data) in &files {
+            let mut f = zip.by_name(name).unwrap();
+            let mut back = Vec::new();
+            f.read_to_end(&mut back).unwrap();
+            assert_eq!(&back, data);
+            let mode = f.unix_mode().unwrap() & 0o777;
+            assert_eq!(mode, if name.ends_with(".so") { 0o755 } else { 0o644 });
         }
     }
 }

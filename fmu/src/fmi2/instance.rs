@@ -80,6 +80,9 @@ pub trait Model: Sized {
     const ENUMERATIONS: &'static [&'static EnumType];
     /// The default experiment.
     const DEFAULT_EXPERIMENT: DefaultExperiment;
+    /// The first 8 bytes of this model's serialised FMU states (tells its states from other
+    /// data; the GUID inside then tells them from states of other versions of the model).
+    const STATE_MAGIC: [u8; 8];
 
     /// A fresh model; `resources` is the FMU's `resources/` directory when known.
     fn new(resources: Option<PathBuf>) -> Self;
@@ -201,8 +204,8 @@ pub mod mask {
     pub const OUTPUT_DERIVATIVES: u32 = m(&[StepComplete, Terminated, Error]);
 }
 
-const STATE_MAGIC: &[u8; 8] = b"TSFMUST\0";
-const STATE_VERSION: u32 = 1;
+/// Version of the FMU-state byte format: 2 added the trailing checksum over every byte.
+pub const STATE_VERSION: u32 = 2;
 
 /// One instance of a model behind the FMI 2.0 co-simulation interface.
 pub struct Instance<M: Model> {
@@ -499,7 +502,7 @@ impl<M: Model> Instance<M> {
     pub fn save_fmu_state(&self, out: &mut Vec<u8>) -> Result<(), Fmi2Status> {
         self.check_state("fmi2GetFMUstate", mask::GET_STATE)?;
         out.clear();
-        out.extend_from_slice(STATE_MAGIC);
+        out.extend_from_slice(&M::STATE_MAGIC);
         out.put_u32(STATE_VERSION);
         out.put_blob(guid::<M>().as_bytes());
         out.put_u8(self.state.code());
@@ -532,6 +535,8 @@ impl<M: Model> Instance<M> {
         let mut model = Vec::new();
         self.model.save_state(&mut model);
         out.put_blob(&model);
+        let checksum = fnv1a_64(out);
+        out.put_u64(checksum);
         Ok(())
     }
 
@@ -566,15 +571,24 @@ struct ParsedState<'a> {
     model: &'a [u8],
 }
 
-/// Check that `bytes` look like an FMU state of model `M` (magic, version, GUID).
-pub fn check_state_header<M: Model>(bytes: &[u8]) -> Result<(), String> {
+/// Check that `bytes` are an intact FMU state of model `M`: magic, format version, the
+/// checksum over every byte (so any corruption, in the header, the variable values or the
+/// model's own state, is caught here), GUID and the variable section. The model's section is
+/// parsed only by [`Instance::restore_fmu_state`].
+pub fn check_state_bytes<M: Model>(bytes: &[u8]) -> Result<(), String> {
     parse_state::<M>(bytes).map(|_| ())
 }
 
+/// Bytes of the trailing checksum.
+const CHECKSUM_BYTES: usize = 8;
+
 fn parse_state<M: Model>(bytes: &[u8]) -> Result<ParsedState<'_>, String> {
     let mut r = Reader::new(bytes);
-    if r.take(8).ok() != Some(&STATE_MAGIC[..]) {
-        return Err("not a TissueSim FMU state (bad magic)".into());
+    if r.take(8).ok() != Some(&M::STATE_MAGIC[..]) {
+        return Err(format!(
+            "not an FMU state of {} (bad magic)",
+            M::MODEL_IDENTIFIER
+        ));
     }
     let version = r.u32()?;
     if version != STATE_VERSION {
@@ -582,6 +596,20 @@ fn parse_state<M: Model>(bytes: &[u8]) -> Result<ParsedState<'_>, String> {
             "FMU state format version {version} is not supported (expected {STATE_VERSION})"
         ));
     }
+    let Some(body_len) = bytes.len().checked_sub(CHECKSUM_BYTES).filter(|&n| n >= 12) else {
+        return Err(format!("FMU state truncated ({} bytes)", bytes.len()));
+    };
+    let (body, tail) = bytes.split_at(body_len);
+    let stored = u64::from_le_bytes(tail.try_into().expect("8 bytes"));
+    let computed = fnv1a_64(body);
+    if stored != computed {
+        return Err(format!(
+            "FMU state is corrupt: checksum {stored:016x} does not match its {body_len} bytes \
+             ({computed:016x})"
+        ));
+    }
+    let mut r = Reader::new(body);
+    r.take(12)?;
     let g = r.blob()?;
     if g != guid::<M>().as_bytes() {
         return Err(format!(
@@ -657,6 +685,16 @@ pub fn guid<M: Model>() -> String {
     )
 }
 
+/// FNV-1a, 64 bits: the checksum of FMU states. Every step is a bijection of the running hash,
+/// so any change confined to one byte (every single-bit flip) changes the result.
+pub fn fnv1a_64(bytes: &[u8]) -> u64 {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    bytes
+        .iter()
+        .fold(OFFSET, |h, &b| (h ^ b as u64).wrapping_mul(PRIME))
+}
+
 fn fnv1a_128(bytes: &[u8]) -> u128 {
     const OFFSET: u128 = 0x6c62272e07bb014262b821756295c58d;
     const PRIME: u128 = 0x0000000001000000000000000000013B;
@@ -728,6 +766,7 @@ mod tests {
             stop_time: 1.0,
             step_size: 0.1,
         };
+        const STATE_MAGIC: [u8; 8] = *b"TOYSTATE";
         fn new(_: Option<PathBuf>) -> Self {
             Toy {
                 y: 0.0,
@@ -909,6 +948,34 @@ mod tests {
         version[8] = 99;
         assert!(b.restore_fmu_state(&version).is_err());
         assert_eq!(b.time(), 0.5);
+    }
+
+    /// Every single-bit flip anywhere in a state (header, variables, model section, checksum)
+    /// is refused, by the byte check of deserialisation and by restoring, and changes nothing.
+    #[test]
+    fn every_bit_flip_is_refused() {
+        let mut a = initialised();
+        assert_eq!(a.do_step(0.0, 0.25), Fmi2Status::Ok);
+        let mut bytes = Vec::new();
+        a.save_fmu_state(&mut bytes).unwrap();
+        check_state_bytes::<Toy>(&bytes).unwrap();
+        assert_eq!(a.do_step(0.25, 0.25), Fmi2Status::Ok);
+        let y = get(&mut a, 1);
+        for bit in 0..bytes.len() * 8 {
+            let mut bad = bytes.clone();
+            bad[bit / 8] ^= 1 << (bit % 8);
+            assert!(
+                check_state_bytes::<Toy>(&bad).is_err(),
+                "bit {bit} accepted"
+            );
+            assert!(a.restore_fmu_state(&bad).is_err(), "bit {bit} restored");
+        }
+        assert_eq!(a.time(), 0.5);
+        assert_eq!(get(&mut a, 1).to_bits(), y.to_bits());
+        a.restore_fmu_state(&bytes).unwrap();
+        assert_eq!(a.time(), 0.25);
+        assert_eq!(fnv1a_64(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv1a_64(b"a"), 0xaf63_dc4c_8601_ec8c);
     }
 
     #[test]

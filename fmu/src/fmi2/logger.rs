@@ -65,7 +65,7 @@ impl Category {
                 "Why a call returned fmi2Fatal (on unless switched off by name)"
             }
             Category::Calls => "Debug: every FMI call with its arguments",
-            Category::Model => "Debug: what the model does (world built, mesh, fixed nodes)",
+            Category::Model => "Debug: what the model does",
         }
     }
     /// True for the debug categories (`logCalls`, `logModel`), false for the status ones.
@@ -216,6 +216,10 @@ mod tests {
 
     static SEEN: Mutex<Vec<(i32, String, String)>> = Mutex::new(Vec::new());
 
+    /// # Safety
+    ///
+    /// `category` and `message` are NUL-terminated strings alive during the call (as
+    /// [`Logger::log`] passes them).
     unsafe extern "C" fn record(
         _env: Fmi2ComponentEnvironment,
         _name: *const c_char,
@@ -223,8 +227,12 @@ mod tests {
         category: *const c_char,
         message: *const c_char,
     ) {
-        let c = CStr::from_ptr(category).to_string_lossy().into_owned();
-        let m = CStr::from_ptr(message).to_string_lossy().into_owned();
+        // SAFETY: both are NUL-terminated `CString`s of `Logger::log`, alive during the call.
+        let (c, m) = unsafe { (CStr::from_ptr(category), CStr::from_ptr(message)) };
+        let (c, m) = (
+            c.to_string_lossy().into_owned(),
+            m.to_string_lossy().into_owned(),
+        );
         SEEN.lock().unwrap().push((status as i32, c, m));
     }
 
@@ -239,7 +247,9 @@ mod tests {
             *const c_char,
             *const c_char,
         );
-        // SAFETY: see above; same leading parameters.
+        // SAFETY: `Fixed` and the logger type have the same leading parameters; the C ABI of
+        // x86-64 and AArch64 passes them identically to a variadic callee, and `record` reads
+        // no variadic argument (see above).
         unsafe { std::mem::transmute::<Fixed, Fmi2CallbackLogger>(record as Fixed) }
     }
 

@@ -69,6 +69,12 @@ pub const FMI2_LAST_SUCCESSFUL_TIME: Fmi2StatusKind = 2;
 pub const FMI2_TERMINATED: Fmi2StatusKind = 3;
 
 /// `fmi2CallbackLogger`: variadic, `message` is a printf format (hence `%` escaped as `%%`).
+///
+/// # Safety
+///
+/// A foreign function of the master: callers pass the master's `componentEnvironment`, and
+/// NUL-terminated strings alive during the call, with a format string that reads no variadic
+/// argument (see `logger::Logger::log`).
 pub type Fmi2CallbackLogger = unsafe extern "C" fn(
     Fmi2ComponentEnvironment,
     Fmi2String,
@@ -78,10 +84,22 @@ pub type Fmi2CallbackLogger = unsafe extern "C" fn(
     ...
 );
 /// `fmi2CallbackAllocateMemory`.
+///
+/// # Safety
+///
+/// A foreign function of the master; never called (`canNotUseMemoryManagementFunctions`).
 pub type Fmi2CallbackAllocateMemory = unsafe extern "C" fn(usize, usize) -> *mut c_void;
 /// `fmi2CallbackFreeMemory`.
+///
+/// # Safety
+///
+/// A foreign function of the master; never called (`canNotUseMemoryManagementFunctions`).
 pub type Fmi2CallbackFreeMemory = unsafe extern "C" fn(*mut c_void);
 /// `fmi2StepFinished`.
+///
+/// # Safety
+///
+/// A foreign function of the master; never called (steps are synchronous).
 pub type Fmi2StepFinished = unsafe extern "C" fn(Fmi2ComponentEnvironment, Fmi2Status);
 
 /// `fmi2CallbackFunctions`, as passed to `fmi2Instantiate` (copied by the instance).

@@ -2,6 +2,11 @@
 //! start values, ranges, descriptions) and the store of current values indexed by value
 //! reference. Both `modelDescription.xml` ([`super::xml`]) and the compiled getters/setters
 //! ([`super::instance`]) read the same table, so they cannot disagree.
+//!
+//! A model declares its variables once with [`fmi2_variables!`](crate::fmi2_variables), which
+//! numbers the rows (value reference = row) and generates the table and one value-reference
+//! constant per row; the XML, the docs table ([`super::docs`]) and the model's code all follow
+//! from it.
 
 use std::fmt;
 
@@ -171,6 +176,110 @@ pub struct Variable {
 }
 
 impl Variable {
+    /// A Real variable (value reference 0 until placed by [`fmi2_variables!`]).
+    ///
+    /// [`fmi2_variables!`]: crate::fmi2_variables
+    #[allow(clippy::too_many_arguments)]
+    pub const fn real(
+        name: &'static str,
+        causality: Causality,
+        variability: Variability,
+        unit: &'static str,
+        start: Option<f64>,
+        min: Option<f64>,
+        max: Option<f64>,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr: 0,
+            causality,
+            variability,
+            kind: Kind::Real {
+                unit,
+                start,
+                min,
+                max,
+            },
+            description,
+        }
+    }
+    /// An Integer variable.
+    pub const fn integer(
+        name: &'static str,
+        causality: Causality,
+        variability: Variability,
+        start: Option<i32>,
+        min: Option<i32>,
+        max: Option<i32>,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr: 0,
+            causality,
+            variability,
+            kind: Kind::Integer { start, min, max },
+            description,
+        }
+    }
+    /// An Enumeration variable of type `ty`.
+    pub const fn enumeration(
+        name: &'static str,
+        causality: Causality,
+        variability: Variability,
+        ty: &'static EnumType,
+        start: i32,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr: 0,
+            causality,
+            variability,
+            kind: Kind::Enumeration { ty, start },
+            description,
+        }
+    }
+    /// A Boolean variable.
+    pub const fn boolean(
+        name: &'static str,
+        causality: Causality,
+        variability: Variability,
+        start: bool,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr: 0,
+            causality,
+            variability,
+            kind: Kind::Boolean { start },
+            description,
+        }
+    }
+    /// A String variable.
+    pub const fn string(
+        name: &'static str,
+        causality: Causality,
+        variability: Variability,
+        start: &'static str,
+        description: &'static str,
+    ) -> Variable {
+        Variable {
+            name,
+            vr: 0,
+            causality,
+            variability,
+            kind: Kind::String { start },
+            description,
+        }
+    }
+    /// This variable with value reference `vr`.
+    pub const fn at(self, vr: u32) -> Variable {
+        Variable { vr, ..self }
+    }
+
     /// True when the master may set this variable in the given phase.
     pub fn settable(&self, phase: Phase) -> bool {
         match self.causality {
@@ -430,4 +539,49 @@ pub fn check_table(table: &[Variable], units: &[UnitDefinition]) -> Result<(), S
         }
     }
     Ok(())
+}
+
+/// Declare a model's variables once: the table (value reference = row, in order) and a module
+/// of value-reference constants, one per row, named by the row's identifier.
+///
+/// ```ignore
+/// fmi2_variables! {
+///     /// Value references.
+///     pub mod vr;
+///     /// The variable table.
+///     pub static VARIABLES = [
+///         U = Variable::real("u", Input, Continuous, "m", Some(0.0), None, None, "input"),
+///         Y = Variable::real("y", Output, Continuous, "m", None, None, None, "output"),
+///     ];
+/// }
+/// // vr::U == 0, vr::Y == 1, VARIABLES[1].vr == vr::Y,
+/// // vr::IDENTIFIERS == ["U", "Y"] (to check them against the variable names).
+/// ```
+#[macro_export]
+macro_rules! fmi2_variables {
+    (
+        $(#[$vr_meta:meta])* $vr_vis:vis mod $vr_mod:ident;
+        $(#[$t_meta:meta])* $t_vis:vis static $table:ident = [
+            $( $name:ident = $def:expr ),* $(,)?
+        ];
+    ) => {
+        $(#[$vr_meta])*
+        $vr_vis mod $vr_mod {
+            #[allow(non_camel_case_types, clippy::upper_case_acronyms, dead_code)]
+            #[repr(u32)]
+            enum Row {
+                $($name),*
+            }
+            $(
+                #[doc = concat!("Value reference of row `", stringify!($name), "`.")]
+                pub const $name: u32 = Row::$name as u32;
+            )*
+            /// The row identifiers, in table order.
+            pub const IDENTIFIERS: &[&str] = &[$(stringify!($name)),*];
+        }
+        $(#[$t_meta])*
+        $t_vis static $table: &[$crate::fmi2::Variable] = &[
+            $( $crate::fmi2::Variable::at($def, $vr_mod::$name) ),*
+        ];
+    };
 }
