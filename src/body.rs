@@ -129,7 +129,7 @@ pub struct BodyOptions {
     /// Contact radius of the particles (m); `None` derives it from the particle spacing.
     pub particle_radius: Option<Real>,
     /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
-    /// divergence theorem (variationally consistent integration, [`crate::consistency`]): a
+    /// divergence theorem (variationally consistent integration, Chen, Hillman & Rüter 2013): a
     /// uniform stress then leaves interior particles in equilibrium on any point set, and the
     /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
     /// gradients of the paper (for comparison only).
@@ -169,7 +169,7 @@ impl BodyOptions {
 
     /// Check the material and the radii against a mesh of mean edge length `mean_edge` (m):
     /// explicit radii must lie in [`PARTICLE_RADIUS_RANGE`] and [`SUPPORT_RADIUS_RANGE`] (in
-    /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](neighbours::MAX_NEIGHBOURS).
+    /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](crate::MAX_NEIGHBOURS).
     pub fn check_radii(&self, mean_edge: Real) -> Result<(), Error> {
         self.validate()?;
         for (name, value, (lo, hi)) in [
@@ -532,7 +532,11 @@ impl Body {
         }
         self.inertial_mass.copy_from_slice(&self.mass);
         self.update_inverse_masses();
-        self.omega_max = crate::stability::max_angular_frequency(self);
+        self.omega_max = crate::stability::max_angular_frequency(
+            self.rest_positions(),
+            self.inertial_masses(),
+            |x| self.elastic_forces_at(x),
+        );
         if settings.mass_scaling {
             let h = settings.dt / settings.min_substeps as Real;
             let omega_target = 2.0 * settings.stability_margin / h;
@@ -553,7 +557,11 @@ impl Body {
                     *mi = m0.max(factor * k / (omega_target * omega_target));
                 }
                 self.update_inverse_masses();
-                self.omega_max = crate::stability::max_angular_frequency(self);
+                self.omega_max = crate::stability::max_angular_frequency(
+                    self.rest_positions(),
+                    self.inertial_masses(),
+                    |x| self.elastic_forces_at(x),
+                );
                 factor *= (self.omega_max / omega_target).powi(2).max(1.1);
             }
         }

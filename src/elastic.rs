@@ -337,3 +337,23 @@ fn particle_pair_forces(
     }
     fi
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rotation of an overflowing or underflowing deformation gradient returns, finite
+    /// (the SVD fallback is bounded): moved here from the robustness tests when `elastic`
+    /// became crate-private.
+    #[test]
+    fn rotation_of_an_overflowing_deformation_gradient_returns_finite() {
+        for f in [
+            Mat3::from_element(1e300),
+            Mat3::new(1e300, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1e300),
+            Mat3::from_element(Real::MIN_POSITIVE),
+        ] {
+            let q = rotation_from_svd(&f);
+            assert!(q.coords.iter().all(|c| c.is_finite()), "{f}");
+        }
+    }
+}

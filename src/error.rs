@@ -4,7 +4,11 @@ use crate::mesh::MeshError;
 use std::fmt;
 
 /// Why an operation failed. Whatever failed left the world as it was.
+///
+/// `#[non_exhaustive]`: match with a wildcard arm, new variants may come in minor versions.
+/// [`std::error::Error::source`] gives the underlying [`MeshError`] of [`Error::Mesh`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     /// A mesh file could not be read or is malformed (names the file and, where known, the line).
     Mesh(MeshError),
@@ -18,15 +22,8 @@ pub enum Error {
     UnknownTool(u32),
     /// No render surface with this id exists in the world.
     UnknownRenderSurface(u32),
-    /// A caller-provided buffer is too small: `needed` elements are required.
-    BufferTooSmall {
-        /// Number of elements the buffer must hold.
-        needed: usize,
-    },
     /// A saved state cannot be restored into this world (version, size or scene mismatch).
     BadState(String),
-    /// An I/O error other than a mesh read (writing a VTU file, for instance).
-    Io(String),
     /// A step produced NaN or Inf; the world was rolled back to its state before the step.
     Diverged(String),
 }
@@ -40,17 +37,20 @@ impl fmt::Display for Error {
             Error::UnknownBody(id) => write!(f, "unknown body id {id}"),
             Error::UnknownTool(id) => write!(f, "unknown tool id {id}"),
             Error::UnknownRenderSurface(id) => write!(f, "unknown render surface id {id}"),
-            Error::BufferTooSmall { needed } => {
-                write!(f, "buffer too small: {needed} elements needed")
-            }
             Error::BadState(m) => write!(f, "cannot restore state: {m}"),
-            Error::Io(m) => write!(f, "I/O error: {m}"),
             Error::Diverged(m) => write!(f, "step diverged and was rolled back: {m}"),
         }
     }
 }
 
-impl std::error::Error for Error {}
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Mesh(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 impl From<MeshError> for Error {
     fn from(e: MeshError) -> Self {

@@ -24,28 +24,36 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod body;
-pub mod collision;
-pub mod consistency;
-pub mod constraints;
+pub(crate) mod body;
+pub(crate) mod collision;
+pub(crate) mod consistency;
+pub(crate) mod constraints;
 pub(crate) mod divergence;
-pub mod elastic;
-pub mod error;
+pub(crate) mod elastic;
+pub(crate) mod error;
 pub mod ffi;
-pub mod math;
+pub(crate) mod math;
 pub mod mesh;
-pub mod neighbours;
-pub mod parallel;
+pub(crate) mod neighbours;
+pub(crate) mod parallel;
 pub mod render;
-pub mod settings;
-pub mod stability;
+pub(crate) mod settings;
+pub(crate) mod stability;
 pub mod state;
 pub mod statics;
-pub mod world;
+pub(crate) mod world;
 
-pub use body::{Body, BodyOptions, Material};
-pub use collision::tool::{Pose, Tool, ToolOptions, ToolShape, Wrench};
+pub use body::{
+    Body, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
+    PARTICLE_RADIUS_RANGE, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT, SUPPORT_RADIUS_RANGE,
+    YOUNGS_MODULUS_RANGE,
+};
+pub use collision::tool::{
+    Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
+    TOOL_SIZE_RANGE,
+};
 pub use error::Error;
-pub use math::{Mat3, Quat, Real, Vec3};
+pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
+pub use neighbours::MAX_NEIGHBOURS;
 pub use settings::{ContactMode, DivergenceLimits, Settings};
 pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World};

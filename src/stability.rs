@@ -4,7 +4,6 @@
 //! Symplectic Euler is stable for a substep `h < 2/ω_max`; the world chooses its number of
 //! substeps from this (and reports when `Settings::max_substeps` is not enough).
 
-use crate::body::Body;
 use crate::math::{Real, Vec3};
 
 /// Power iterations used for the estimate.
@@ -13,15 +12,16 @@ const ITERATIONS: usize = 60;
 /// Safety factor on the power-iteration estimate (it approaches `ω_max` from below).
 const SAFETY: Real = 1.05;
 
-/// Estimate `ω_max` (rad/s) of `body` with every particle free, with its inertial masses.
-pub fn max_angular_frequency(body: &Body) -> Real {
-    let n = body.particle_count();
-    let rest = body.rest_positions();
-    let inv_sqrt_m: Vec<Real> = body
-        .inertial_masses()
-        .iter()
-        .map(|m| 1.0 / m.sqrt())
-        .collect();
+/// Estimate `ω_max` (rad/s) of a body with every particle free: `rest` its rest positions (m),
+/// `masses` its inertial masses (kg), `elastic_forces_at` its elastic forces (N) at given
+/// positions. (The body passes these in, so this module does not depend on the body type.)
+pub(crate) fn max_angular_frequency(
+    rest: &[Vec3],
+    masses: &[Real],
+    elastic_forces_at: impl Fn(&[Vec3]) -> Vec<Vec3>,
+) -> Real {
+    let n = rest.len();
+    let inv_sqrt_m: Vec<Real> = masses.iter().map(|m| 1.0 / m.sqrt()).collect();
     // Deterministic start vector with energy in every particle and direction.
     let mut y: Vec<Vec3> = (0..n)
         .map(|i| {
@@ -41,7 +41,7 @@ pub fn max_angular_frequency(body: &Body) -> Real {
         for i in 0..n {
             x[i] = rest[i] + y[i] * (inv_sqrt_m[i] * eps);
         }
-        let f = body.elastic_forces_at(&x);
+        let f = elastic_forces_at(&x);
         // K z = -f / eps with z = M^{-1/2} y; then A y = M^{-1/2} K z.
         let mut ay: Vec<Vec3> = (0..n).map(|i| -f[i] * (inv_sqrt_m[i] / eps)).collect();
         lambda = ay.iter().zip(&y).map(|(a, b)| a.dot(b)).sum::<Real>();

@@ -140,9 +140,9 @@ impl World {
 
     /// Restore a state written by [`World::save_state`] of a world built the same way. On any
     /// mismatch (magic, version, counts, size, checksum, non-finite values, a particle
-    /// farther than [`STATE_POSITION_LIMIT`](crate::body::STATE_POSITION_LIMIT) body sizes from
+    /// farther than [`STATE_POSITION_LIMIT`](crate::STATE_POSITION_LIMIT) body sizes from
     /// its body's rest centre or faster than
-    /// [`STATE_SPEED_LIMIT`](crate::body::STATE_SPEED_LIMIT) body sizes per second) the world
+    /// [`STATE_SPEED_LIMIT`](crate::STATE_SPEED_LIMIT) body sizes per second) the world
     /// is left unchanged and [`Error::BadState`] says why.
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), Error> {
         let bad = |m: &str| Err(Error::BadState(m.to_string()));

@@ -150,8 +150,8 @@ impl World {
     }
     /// Set the positions (m) and velocities (m/s) of every particle of a body, e.g. an initial
     /// condition. Both slices must have one entry per particle and be finite, within
-    /// [`STATE_POSITION_LIMIT`](crate::body::STATE_POSITION_LIMIT) body sizes of the body's
-    /// rest centre and below [`STATE_SPEED_LIMIT`](crate::body::STATE_SPEED_LIMIT) body sizes
+    /// [`STATE_POSITION_LIMIT`](crate::STATE_POSITION_LIMIT) body sizes of the body's
+    /// rest centre and below [`STATE_SPEED_LIMIT`](crate::STATE_SPEED_LIMIT) body sizes
     /// per second; fixed particles take the given position and zero velocity. Nothing changes
     /// on error.
     pub fn set_body_state(

@@ -2,8 +2,8 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use tissuesim::math::tet_volume;
 use tissuesim::mesh::{self, lattice_box, MeshError, TetMesh};
+use tissuesim::tet_volume;
 use tissuesim::Vec3;
 
 mod common;

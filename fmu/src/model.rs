@@ -22,7 +22,7 @@ use crate::fmi2::{
 };
 
 use std::path::{Path, PathBuf};
-use tissuesim::math::Quat;
+use tissuesim::Quat;
 use tissuesim::{
     mesh, BodyId, BodyOptions, Error, Material, Pose, Settings, ToolId, ToolOptions, ToolShape,
     Vec3, World,
@@ -123,7 +123,7 @@ crate::fmi2_variables! {
         MAX_DISPLACEMENT = output("max_displacement", "m", "Largest distance of an organ particle from its rest position at the end of the step"),
         MAX_PENETRATION = output("max_penetration", "m", "Largest penetration of a particle into the tool before projection, last internal step"),
         YOUNGS_MODULUS = param("youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
-        POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::body::MIN_POISSON_RATIO), Some(tissuesim::body::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
+        POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::MIN_POISSON_RATIO), Some(tissuesim::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
         DENSITY = param("density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
         DAMPING = param("damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
         FRICTION_STATIC = param("friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),
@@ -398,7 +398,7 @@ fn run_steps(
         let pose = if k == n {
             to
         } else {
-            interpolate(&from, &to, k as f64 / n as f64)
+            Pose::interpolate(&from, &to, k as f64 / n as f64)
         };
         sim.world.set_tool_pose(sim.tool, pose).map_err(solver)?;
         let report = sim.world.step().map_err(solver)?;
@@ -437,54 +437,17 @@ pub fn substeps(h: f64, max_dt: f64) -> Result<u64, String> {
     Ok((n as u64).max(1))
 }
 
-/// The pose of the inputs; the quaternion is normalised, a zero or tiny one is an error.
+/// The pose of the inputs, by the core's one conversion of raw poses
+/// ([`Pose::from_components`]: finite, quaternion normalised, a zero or tiny one refused).
 pub fn pose_from_inputs(store: &Store) -> Result<Pose, String> {
-    let p = Vec3::new(
-        store.real(vr::TOOL_PX),
-        store.real(vr::TOOL_PY),
-        store.real(vr::TOOL_PZ),
-    );
-    let q = nalgebra::Quaternion::new(
-        store.real(vr::TOOL_QW),
-        store.real(vr::TOOL_QX),
-        store.real(vr::TOOL_QY),
-        store.real(vr::TOOL_QZ),
-    );
-    let norm = q.norm();
-    if !(norm.is_finite() && norm > 1e-9) {
-        return Err(format!(
-            "tool orientation quaternion (tool_qw, tool_qx, tool_qy, tool_qz) = ({}, {}, {}, {}) has norm {norm}: it must be a non-zero quaternion",
-            q.w, q.i, q.j, q.k
-        ));
-    }
-    Ok(Pose {
-        position: p,
-        orientation: Quat::new_normalize(q),
+    let position = [vr::TOOL_PX, vr::TOOL_PY, vr::TOOL_PZ].map(|r| store.real(r));
+    let quaternion = [vr::TOOL_QW, vr::TOOL_QX, vr::TOOL_QY, vr::TOOL_QZ].map(|r| store.real(r));
+    Pose::from_components(position, quaternion).map_err(|e| {
+        format!(
+            "tool pose (tool_px, tool_py, tool_pz) = {position:?}, (tool_qw, tool_qx, tool_qy, \
+             tool_qz) = {quaternion:?}: {e}; the quaternion must be finite and non-zero"
+        )
     })
-}
-
-/// Pose at fraction `s` in [0, 1] from `a` to `b`: linear in position, slerp (shortest arc) in
-/// orientation; never panics (near-equal orientations fall back to normalised lerp).
-pub fn interpolate(a: &Pose, b: &Pose, s: f64) -> Pose {
-    let position = a.position + (b.position - a.position) * s;
-    let qa = a.orientation.into_inner().coords;
-    let mut qb = b.orientation.into_inner().coords;
-    let mut dot = qa.dot(&qb);
-    if dot < 0.0 {
-        qb = -qb;
-        dot = -dot;
-    }
-    let coords = if dot > 0.9995 {
-        qa * (1.0 - s) + qb * s
-    } else {
-        let theta = dot.clamp(-1.0, 1.0).acos();
-        let sin = theta.sin();
-        qa * (((1.0 - s) * theta).sin() / sin) + qb * ((s * theta).sin() / sin)
-    };
-    Pose {
-        position,
-        orientation: Quat::new_normalize(nalgebra::Quaternion::from(coords)),
-    }
 }
 
 fn fixed_values(store: &Store) -> Vec<Value> {
@@ -735,11 +698,11 @@ mod tests {
             position: Vec3::new(1.0, 2.0, 3.0),
             orientation: Quat::from_axis_angle(&Vec3::y_axis(), std::f64::consts::PI),
         };
-        let m = interpolate(&a, &b, 0.5);
+        let m = Pose::interpolate(&a, &b, 0.5);
         assert!((m.position - Vec3::new(0.5, 1.0, 1.5)).norm() < 1e-15);
         assert!((m.orientation.angle() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         assert!(
-            (interpolate(&a, &b, 1.0)
+            (Pose::interpolate(&a, &b, 1.0)
                 .orientation
                 .angle_to(&b.orientation))
                 < 1e-12
@@ -749,7 +712,7 @@ mod tests {
             position: Vec3::zeros(),
             orientation: Quat::new_unchecked(-a.orientation.into_inner()),
         };
-        assert!(interpolate(&a, &c, 0.3).orientation.angle() < 1e-12);
+        assert!(Pose::interpolate(&a, &c, 0.3).orientation.angle() < 1e-12);
     }
 
     #[test]

@@ -29,11 +29,6 @@ impl HashGrid {
         self.bucket_of = vec![0; particles];
     }
 
-    /// Cell size (m).
-    pub fn cell_size(&self) -> Real {
-        self.cell
-    }
-
     #[inline]
     fn bucket(&self, c: [i64; 3]) -> usize {
         let h = (c[0].wrapping_mul(73_856_093))

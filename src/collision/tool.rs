@@ -54,7 +54,7 @@ impl ToolShape {
     /// Check the shape: NaN or ±Inf give [`Error::NonFinite`]; otherwise radii, cylinder
     /// half-heights and box half-extents must be > 0 m, a capsule's half-height ≥ 0 m (0 is a
     /// sphere), a convex hull needs at least 4 points not all in one plane (within
-    /// [`CONVEX_HULL_FLATNESS`] of their extent), a triangle mesh at least one triangle and
+    /// [`CONVEX_HULL_FLATNESS`](crate::CONVEX_HULL_FLATNESS) of their extent), a triangle mesh at least one triangle and
     /// indices within its vertices; else [`Error::InvalidArgument`]. The one validation of tool
     /// shapes, used by [`World::add_tool`](crate::World::add_tool) and the C API.
     pub fn validate(&self) -> Result<(), Error> {
@@ -182,7 +182,7 @@ impl Pose {
     }
 
     /// A pose from a position (m) and a quaternion `(w, x, y, z)`, normalised here. NaN/Inf give
-    /// [`Error::NonFinite`], a quaternion of norm below [`MIN_QUATERNION_NORM`]
+    /// [`Error::NonFinite`], a quaternion of norm below [`MIN_QUATERNION_NORM`](crate::MIN_QUATERNION_NORM)
     /// [`Error::InvalidArgument`]. The one conversion of raw poses (the C API uses it too).
     pub fn from_components(position: [Real; 3], quaternion: [Real; 4]) -> Result<Self, Error> {
         let p = Vec3::from(position);

@@ -39,9 +39,7 @@ pub fn status_of(e: &Error) -> ts_status {
         Error::UnknownBody(_) => ts_status::UnknownBody,
         Error::UnknownTool(_) => ts_status::UnknownTool,
         Error::UnknownRenderSurface(_) => ts_status::UnknownRenderSurface,
-        Error::BufferTooSmall { .. } => ts_status::BufferTooSmall,
         Error::BadState(_) => ts_status::BadState,
-        Error::Io(_) => ts_status::IoError,
         Error::Diverged(_) => ts_status::Diverged,
     }
 }

@@ -23,7 +23,7 @@ fn drop_payload(payload: Box<dyn Any + Send>) {
 }
 
 /// Run `body`: `Ok` gives `TS_STATUS_OK`; an error stores its message as the thread's last
-/// error and returns its status; a panic stores "internal panic: <message>" and returns
+/// error and returns its status; a panic stores "internal panic: `<message>`" and returns
 /// `TS_STATUS_PANIC`.
 pub fn guard(body: impl FnOnce() -> FfiResult) -> ts_status {
     match catch_unwind(AssertUnwindSafe(body)) {

@@ -9,8 +9,8 @@ use crate::math::{Real, Vec3};
 use crate::world::BodyId;
 use std::path::Path;
 
-/// A render mesh bound once to the rest tetrahedra of a body. [`update`](Self::update) (or
-/// `World::update_render_surface`) recomputes the deformed vertex positions (m) and the
+/// A render mesh bound once to the rest tetrahedra of a body.
+/// [`World::update_render_surface`](crate::World::update_render_surface) recomputes the deformed vertex positions (m) and the
 /// per-vertex normals (area-weighted face normals, renormalised) from the body's particles,
 /// without allocating; the getters return the last update.
 #[derive(Debug, Clone)]

@@ -127,7 +127,7 @@ pub fn tet_volumes(x: &[Vec3], tets: &[[u32; 4]]) -> Vec<Real> {
     tets.iter()
         .map(|t| {
             let [a, b, c, d] = t.map(|k| x[k as usize]);
-            tissuesim::math::tet_volume(&a, &b, &c, &d)
+            tissuesim::tet_volume(&a, &b, &c, &d)
         })
         .collect()
 }
