@@ -275,6 +275,63 @@ static void test_coverage(double h) {
     ts_world_free(world);
 }
 
+/* Grasping: a sphere touching the top of a free lattice grasps it (ts_tool_grasp), holds it
+ * hanging for 2 s: the pull on the tool equals the lattice's weight (within 5%); release lets
+ * it fall away. Bad options and stale ids give their statuses. */
+static void test_grasp(double h) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    uint32_t body = 99, ball = 99, count = 99;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
+    double radius = 0;
+    CHECK_OK(ts_body_particle_radius(world, body, &radius));
+    ts_pose top = {{OX + CELLS * h / 2, CELLS * h + 0.01 + 0.5 * radius, CELLS * h / 2},
+                   {1, 0, 0, 0}};
+    CHECK_OK(ts_world_add_tool_sphere(world, 0.01, &top, NULL, &ball));
+    ts_grasp_options g;
+    CHECK_OK(ts_grasp_options_default(&g));
+    CHECK(g.reach == 0 && g.compliance < 0 && isinf(g.max_force));
+    CHECK_ST(ts_grasp_options_default(NULL), TS_STATUS_NULL_PARAMETER);
+    g.reach = NAN;
+    CHECK_ST(ts_tool_grasp(world, ball, &g, &count), TS_STATUS_NON_FINITE);
+    CHECK(count == 99); /* outputs only on success */
+    g.reach = 0;
+    g.max_force = -1;
+    CHECK_ST(ts_tool_grasp(world, ball, &g, &count), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_tool_grasp(world, 9, NULL, &count), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_tool_grasp(NULL, ball, NULL, &count), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_tool_grasp(world, ball, NULL, &count));
+    CHECK(count > 0);
+    uint32_t held = 0;
+    CHECK_OK(ts_tool_grasped_count(world, ball, &held));
+    CHECK(held == count);
+    CHECK_ST(ts_tool_grasped_count(world, ball, NULL), TS_STATUS_NULL_PARAMETER);
+    ts_wrench w;
+    double pull = 0;
+    for (int s = 0; s < 2000; s++) {
+        CHECK_OK(ts_world_step(world, NULL));
+        if (s >= 1500) {
+            CHECK_OK(ts_tool_wrench(world, ball, &w));
+            pull -= w.force[1] / 500;
+        }
+    }
+    double weight = material.density * (CELLS * h) * (CELLS * h) * (CELLS * h) * 9.81;
+    printf("grasp: %u particles hold %.4f N of a %.4f N lattice\n", count, pull, weight);
+    CHECK(fabs(pull - weight) < 0.05 * weight);
+    CHECK_OK(ts_tool_release(world, ball));
+    CHECK_OK(ts_tool_grasped_count(world, ball, &held));
+    CHECK(held == 0);
+    CHECK_ST(ts_tool_release(world, 9), TS_STATUS_UNKNOWN_TOOL);
+    for (int s = 0; s < 100; s++) CHECK_OK(ts_world_step(world, NULL));
+    CHECK_OK(ts_tool_wrench(world, ball, &w));
+    CHECK(w.contact_count == 0 && w.force[1] == 0); /* fell away */
+    ts_world_free(world);
+}
+
 int main(void) {
     long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
     if (steps < 2) steps = 2;
@@ -282,6 +339,7 @@ int main(void) {
     build_lattice(h);
     test_settle(h);
     test_coverage(h);
+    test_grasp(h);
 
     /* ---- version, status strings, last error ---- */
     CHECK(ts_version() == TISSUESIM_VERSION);

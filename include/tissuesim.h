@@ -355,6 +355,28 @@ typedef struct ts_wrench {
     uint32_t contact_count;
 } ts_wrench;
 
+/**
+ * How a tool grasps. ts_grasp_options_default gives automatic reach and compliance and a grasp
+ * that never slips.
+ */
+typedef struct ts_grasp_options {
+    /**
+     * Particles within this distance (m) of the tool's surface are grasped; 0 means automatic
+     * (1.5 x the body's particle radius).
+     */
+    double reach;
+    /**
+     * Compliance of each attachment (m/N; 0 = rigid); negative means automatic (1 / (E r),
+     * E the body's Young's modulus, r its particle radius).
+     */
+    double compliance;
+    /**
+     * Largest total pull (N) the grasp holds before the tissue slips out; 0 or INFINITY means
+     * it never slips.
+     */
+    double max_force;
+} ts_grasp_options;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1041,6 +1063,55 @@ enum ts_status ts_tool_set_friction(struct ts_world *world,
 enum ts_status ts_tool_get_options(const struct ts_world *world,
                                    uint32_t tool,
                                    struct ts_tool_options *out_options);
+
+/**
+ * Write the default grasp options into *out.
+ *
+ * # Safety
+ *
+ * `out` is NULL or writable.
+ */
+enum ts_status ts_grasp_options_default(struct ts_grasp_options *out);
+
+/**
+ * Grasp with `tool`: every free particle within reach of its surface is attached to the tool
+ * where it is now, and follows the tool (compliant constraints) until ts_tool_release or until
+ * the pull exceeds `max_force` (the tissue slips). `options` may be NULL (defaults). The number
+ * of grasped particles goes to *out_count when `out_count` is not NULL (0: nothing within
+ * reach, not an error). A grasp replaces the tool's previous one. NaN gives
+ * TS_STATUS_NON_FINITE, a negative reach or max_force TS_STATUS_INVALID_ARGUMENT; nothing
+ * changes on error.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `options` is NULL or readable; `out_count` is NULL or
+ * writable.
+ */
+enum ts_status ts_tool_grasp(struct ts_world *world,
+                             uint32_t tool,
+                             const struct ts_grasp_options *options,
+                             uint32_t *out_count);
+
+/**
+ * Release `tool`'s grasp: the tissue is free again (contact with the tool still acts).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_tool_release(struct ts_world *world, uint32_t tool);
+
+/**
+ * The number of particles `tool` holds into *out_count (0 when not grasping or after the
+ * tissue slipped).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_count` is NULL or writable.
+ */
+enum ts_status ts_tool_grasped_count(const struct ts_world *world,
+                                     uint32_t tool,
+                                     uint32_t *out_count);
 
 /**
  * Size in bytes of the state ts_world_save_state writes for the world as it is now (it

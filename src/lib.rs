@@ -32,6 +32,7 @@ pub(crate) mod divergence;
 pub(crate) mod elastic;
 pub(crate) mod error;
 pub mod ffi;
+pub mod grasp;
 pub(crate) mod math;
 pub mod mesh;
 pub(crate) mod neighbours;
@@ -53,6 +54,7 @@ pub use collision::tool::{
     TOOL_SIZE_RANGE,
 };
 pub use error::Error;
+pub use grasp::GraspOptions;
 pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use neighbours::MAX_NEIGHBOURS;
 pub use settings::{ContactMode, DivergenceLimits, Settings};

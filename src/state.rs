@@ -10,23 +10,31 @@
 //! | time (s) | f64 |
 //! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
 //! | per tool in the world (removed tools left out), in id order: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
+//! | then its grasp: slip force (N), attachment count, and per attachment body, particle, anchor in the tool frame (m), compliance (m/N) | f64, u32, (u32, u32, f64 × 4)… |
 //! | FNV-1a 64 checksum of everything before it | u64 |
 //!
 //! The scene itself (meshes, materials, fixed particles, settings) is not part of the state: a
-//! state restores into a world built the same way. Restoring then stepping reproduces the
+//! state restores into a world built the same way. Its size depends on the grasps in force
+//! ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
 
 use crate::collision::tool::{Pose, Wrench};
 use crate::error::Error;
-use crate::math::{Quat, Real, Vec3};
+use crate::grasp::{Attachment, Grasp};
+use crate::math::{is_finite_vec, Quat, Real, Vec3};
 use crate::world::World;
 
 /// Version of the byte format written by [`World::save_state`].
-pub const STATE_VERSION: u32 = 1;
+pub const STATE_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
 const HEADER: usize = 8 + 4 + 4 + 4 + 8;
 const TOOL_REALS: usize = 7 + 7 + 3 + 3 + 3 + 1;
+/// Bytes of a tool's fixed part: the reals, the contact count, the slip force, the attachment
+/// count.
+const TOOL_BYTES: usize = TOOL_REALS * 8 + 4 + 8 + 4;
+/// Bytes of one attachment: body, particle, anchor, compliance.
+const ATTACHMENT_BYTES: usize = 4 + 4 + 4 * 8;
 
 fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -104,12 +112,23 @@ impl World {
         HEADER
             + self.bodies.len() * 4
             + particles * 10 * 8
-            + self.tool_count() * (TOOL_REALS * 8 + 4)
+            + self.tool_count() * TOOL_BYTES
+            + self.attachment_count() * ATTACHMENT_BYTES
             + 8
     }
 
+    /// Attachments of the grasps of the tools in the world.
+    fn attachment_count(&self) -> usize {
+        self.tools
+            .iter()
+            .zip(&self.grasps)
+            .filter(|(t, _)| t.is_some())
+            .map(|(_, g)| g.attachments.len())
+            .sum()
+    }
+
     /// Append the dynamic state (time, particle positions, velocities and rotations, tool poses,
-    /// velocities and wrenches) to `out`, in the format of [`crate::state`].
+    /// velocities, wrenches and grasps) to `out`, in the format of [`crate::state`].
     pub fn save_state(&self, out: &mut Vec<u8>) {
         let start = out.len();
         out.reserve(self.state_size());
@@ -125,7 +144,8 @@ impl World {
             b.v.iter().for_each(|v| w.vec3(v));
             b.rotation.iter().for_each(|q| w.quat(q));
         }
-        for t in self.tools.iter().flatten() {
+        for (t, g) in self.tools.iter().zip(&self.grasps) {
+            let Some(t) = t else { continue };
             w.pose(&t.pose);
             w.pose(&t.target);
             w.vec3(&t.linear_velocity);
@@ -133,6 +153,14 @@ impl World {
             w.vec3(&t.wrench.torque);
             w.u32(t.wrench.contact_count);
             w.f64(t.wrench.max_penetration);
+            w.f64(g.max_force);
+            w.u32(g.attachments.len() as u32);
+            for a in &g.attachments {
+                w.u32(a.body);
+                w.u32(a.particle);
+                w.vec3(&a.anchor);
+                w.f64(a.compliance);
+            }
         }
         let sum = fnv1a(&out[start..]);
         out.extend_from_slice(&sum.to_le_bytes());
@@ -159,18 +187,12 @@ impl World {
         if r.u32() as usize != self.bodies.len() || r.u32() as usize != self.tool_count() {
             return bad("body or tool count differs from this world");
         }
-        if bytes.len() != self.state_size() {
-            return Err(Error::BadState(format!(
-                "state is {} bytes, this world's is {}",
-                bytes.len(),
-                self.state_size()
-            )));
-        }
         let body_len = bytes.len() - 8;
         let sum = u64::from_le_bytes(bytes[body_len..].try_into().unwrap_or([0; 8]));
         if fnv1a(&bytes[..body_len]) != sum {
             return bad("checksum mismatch (corrupted state)");
         }
+        let grasps = self.read_grasps(bytes)?;
         // Check particle counts and finiteness before changing anything.
         let mut check = Reader { bytes, at: HEADER };
         for b in &self.bodies {
@@ -206,12 +228,13 @@ impl World {
                 return bad("non-finite particle rotation");
             }
         }
-        for _ in self.tools.iter().flatten() {
+        for g in &grasps {
             let head_finite = (0..TOOL_REALS - 1).all(|_| scan.f64().is_finite());
             scan.at += 4;
             if !head_finite || !scan.f64().is_finite() {
                 return bad("non-finite tool state");
             }
+            scan.at += 12 + g.attachments.len() * ATTACHMENT_BYTES;
         }
         // Everything checked: apply.
         r.at = HEADER - 8;
@@ -222,7 +245,9 @@ impl World {
             b.v.iter_mut().for_each(|v| *v = r.vec3());
             b.rotation.iter_mut().for_each(|q| *q = r.quat());
         }
-        for t in self.tools.iter_mut().flatten() {
+        let mut grasps = grasps.into_iter();
+        for (t, g) in self.tools.iter_mut().zip(&mut self.grasps) {
+            let Some(t) = t else { continue };
             t.pose = r.pose();
             t.target = r.pose();
             t.linear_velocity = r.vec3();
@@ -236,7 +261,83 @@ impl World {
                 contact_count,
                 max_penetration,
             };
+            *g = grasps.next().unwrap_or_default();
+            r.at += 12 + g.attachments.len() * ATTACHMENT_BYTES;
         }
         Ok(())
+    }
+
+    /// The grasps of a state whose header, counts and checksum were checked, one per tool in the
+    /// world, after checking the state's length against the attachment counts it declares and
+    /// every attachment against this world (body, particle, finite anchor, compliance ≥ 0).
+    fn read_grasps(&self, bytes: &[u8]) -> Result<Vec<Grasp>, Error> {
+        let bad = |m: String| Err(Error::BadState(m));
+        let mut at = HEADER;
+        for b in &self.bodies {
+            at += 4 + b.particle_count() * 10 * 8;
+        }
+        let mut grasps = Vec::with_capacity(self.tool_count());
+        for _ in 0..self.tool_count() {
+            if at + TOOL_BYTES + 8 > bytes.len() {
+                return bad(format!(
+                    "state is {} bytes: too short for this world",
+                    bytes.len()
+                ));
+            }
+            let mut r = Reader {
+                bytes,
+                at: at + TOOL_BYTES - 12,
+            };
+            let max_force = r.f64();
+            let count = r.u32() as usize;
+            at += TOOL_BYTES;
+            let end = count
+                .checked_mul(ATTACHMENT_BYTES)
+                .and_then(|n| n.checked_add(at + 8));
+            if !end.is_some_and(|end| end <= bytes.len()) {
+                return bad(format!(
+                    "state declares {count} grasped particles beyond its end"
+                ));
+            }
+            if max_force.is_nan() || max_force <= 0.0 {
+                return bad(format!("grasp slip force {max_force}"));
+            }
+            let mut attachments = Vec::with_capacity(count);
+            for _ in 0..count {
+                let (body, particle) = (r.u32(), r.u32());
+                let (anchor, compliance) = (r.vec3(), r.f64());
+                let known = self
+                    .bodies
+                    .get(body as usize)
+                    .is_some_and(|b| (particle as usize) < b.particle_count());
+                if !(known && is_finite_vec(&anchor) && compliance >= 0.0 && compliance.is_finite())
+                {
+                    return bad(format!(
+                        "grasped particle {particle} of body {body}: unknown or non-finite"
+                    ));
+                }
+                attachments.push(Attachment {
+                    body,
+                    particle,
+                    anchor,
+                    compliance,
+                    lambda: Vec3::zeros(),
+                });
+            }
+            at = r.at;
+            grasps.push(Grasp {
+                attachments,
+                max_force,
+                acc_impulse: Vec3::zeros(),
+            });
+        }
+        if at + 8 != bytes.len() {
+            return bad(format!(
+                "state is {} bytes, this world's layout gives {}",
+                bytes.len(),
+                at + 8
+            ));
+        }
+        Ok(grasps)
     }
 }

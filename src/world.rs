@@ -23,6 +23,7 @@ use crate::constraints::friction::friction_correction;
 use crate::constraints::volume::project_volume_tet;
 use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::error::Error;
+use crate::grasp::{Grasp, GraspOptions};
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::parallel::Pool;
@@ -65,6 +66,8 @@ pub struct World {
     pub(crate) bodies: Vec<Body>,
     /// Tools by id; `None` for a removed tool (ids are never reused).
     pub(crate) tools: Vec<Option<Tool>>,
+    /// The grasp of each tool, by tool id (no attachments: not grasping).
+    pub(crate) grasps: Vec<Grasp>,
     render_surfaces: Vec<RenderSurface>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
@@ -82,6 +85,7 @@ impl World {
             settings,
             bodies: Vec::new(),
             tools: Vec::new(),
+            grasps: Vec::new(),
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             grid: HashGrid::default(),
@@ -277,6 +281,7 @@ impl World {
             .map_err(|_| Error::InvalidArgument("no tool id left".into()))?;
         self.tools
             .push(Some(Tool::new(shape, pose, options, spacing)?));
+        self.grasps.push(Grasp::default());
         Ok(ToolId(id))
     }
     /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
@@ -285,7 +290,31 @@ impl World {
     pub fn remove_tool(&mut self, id: ToolId) -> Result<(), Error> {
         self.tool(id)?;
         self.tools[id.0 as usize] = None;
+        self.grasps[id.0 as usize] = Grasp::default();
         Ok(())
+    }
+    /// Grasp with tool `id`: every free particle within [`GraspOptions::reach`] of the tool's
+    /// surface is attached, where it is now, to the tool (compliant attachment constraints, see
+    /// [`crate::grasp`]), and follows the tool until [`World::release`] or until the tissue
+    /// slips (pull beyond [`GraspOptions::max_force`]). A grasp replaces the tool's previous
+    /// one. Returns the number of grasped particles (0: nothing within reach, not an error).
+    /// Nothing changes on error.
+    pub fn grasp(&mut self, id: ToolId, options: &GraspOptions) -> Result<usize, Error> {
+        let grasp = Grasp::new(self.tool(id)?, &self.bodies, options)?;
+        let count = grasp.attachments.len();
+        self.grasps[id.0 as usize] = grasp;
+        Ok(count)
+    }
+    /// Release tool `id`'s grasp: the tissue is free again (contact with the tool still acts).
+    pub fn release(&mut self, id: ToolId) -> Result<(), Error> {
+        self.tool(id)?;
+        self.grasps[id.0 as usize] = Grasp::default();
+        Ok(())
+    }
+    /// Number of particles tool `id` holds (0 when not grasping, or after the tissue slipped).
+    pub fn grasped_count(&self, id: ToolId) -> Result<usize, Error> {
+        self.tool(id)?;
+        Ok(self.grasps[id.0 as usize].attachments.len())
     }
     /// Number of tools in the world (removed tools not counted).
     pub fn tool_count(&self) -> usize {
@@ -511,6 +540,9 @@ impl World {
                 self.time
             )));
         }
+        for grasp in &mut self.grasps {
+            grasp.end_step(h, n);
+        }
         let dt = self.settings.dt;
         for t in self.tools.iter_mut().flatten() {
             let scale = -1.0 / (h * h * n as Real);
@@ -552,6 +584,7 @@ impl World {
         for t in self.tools.iter_mut().flatten() {
             t.acc_contacts = 0;
         }
+        self.grasps.iter_mut().for_each(Grasp::begin_substep);
         let s_prev = (k - 1) as Real / n as Real;
         let s_cur = k as Real / n as Real;
         for it in 0..self.settings.iterations {
@@ -571,6 +604,14 @@ impl World {
                 for body in &mut self.bodies {
                     let motion = (&prev, &cur);
                     project_tool_contacts(tool, body, motion, mode, max_correction, it == 0);
+                }
+            }
+            for (tool, grasp) in self.tools.iter_mut().zip(&mut self.grasps) {
+                if let Some(tool) = tool {
+                    if !grasp.attachments.is_empty() {
+                        let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                        grasp.project(tool, &mut self.bodies, &cur, h);
+                    }
                 }
             }
         }

@@ -24,8 +24,8 @@ use crate::fmi2::{
 use std::path::{Path, PathBuf};
 use tissuesim::Quat;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, Error, Material, Pose, Settings, ToolId, ToolOptions, ToolShape,
-    Vec3, World,
+    mesh, BodyId, BodyOptions, Error, GraspOptions, Material, Pose, Settings, ToolId, ToolOptions,
+    ToolShape, Vec3, World,
 };
 
 /// Default tool position (m): ~1.7 cm in front (+z) of the default organ's right lobe at
@@ -147,6 +147,8 @@ crate::fmi2_variables! {
         GRAVITY_Z = param("gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
         THREADS = Variable::integer("threads", Parameter, Fixed, Some(1), Some(1), Some(64), "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count"),
         SETTLE = Variable::boolean("settle", Parameter, Fixed, false, "Start at rest: at fmi2ExitInitializationMode the organ is brought to its static equilibrium under gravity (World::settle: Newton static solve, then damped relaxation; velocities zero), so the co-simulation does not start with the organ swinging into place; an organ with no fixed node cannot settle (fmi2Error)"),
+        GRASP = Variable::boolean("grasp", Input, Discrete, false, "Grasp: while true the tool holds the tissue within reach of its surface (compliant attachments; the pull shows in force_*); at each communication step a tool that holds nothing grasps what is within reach, and false releases"),
+        GRASPED_COUNT = Variable::integer("grasped_count", Output, Discrete, None, Some(0), None, "Number of organ particles the tool holds at the end of the step (0 when not grasping)"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -238,6 +240,7 @@ impl Model for TissueSim {
         let settings = settings_from(store, sim.world.settings(), dt);
         self.snapshot.clear();
         sim.world.save_state(&mut self.snapshot);
+        apply_grasp(sim, store.boolean(vr::GRASP)).map_err(|e| ModelError::error(e.to_string()))?;
         let start_pose = sim.pose;
         let result = run_steps(sim, &settings, start_pose, target, n, log);
         match result {
@@ -610,7 +613,24 @@ fn write_outputs(
         store.set_real(vr, v);
     }
     store.set_integer(vr::CONTACT_COUNT, wrench.contact_count as i32);
+    let held = sim.world.grasped_count(sim.tool).map_err(e)?;
+    store.set_integer(vr::GRASPED_COUNT, held as i32);
     Ok(())
+}
+
+/// Follow the `grasp` input: true and holding nothing grasps what is within reach now (default
+/// grasp options), false releases. Stateless (the world's state carries the attachments), so
+/// fmi2SetFMUstate needs nothing more.
+fn apply_grasp(sim: &mut Sim, grasp: bool) -> Result<(), Error> {
+    let held = sim.world.grasped_count(sim.tool)?;
+    match (grasp, held) {
+        (true, 0) => sim
+            .world
+            .grasp(sim.tool, &GraspOptions::default())
+            .map(|_| ()),
+        (false, n) if n > 0 => sim.world.release(sim.tool),
+        _ => Ok(()),
+    }
 }
 
 /// The `resources/scene.txt` written into the FMU: every parameter with its default value,

@@ -665,3 +665,41 @@ def test_wrong_guid_is_refused(md, unzipdir):
                             byref(rec.callbacks), fmi2False, fmi2False)
     assert not c
     assert "GUID" in rec.text()
+
+
+def test_grasp_holds_the_tissue_and_release_lets_go(slaves, vr):
+    """grasp = true after pressing into the organ: pulling the tool back out drags the tissue,
+    whose pull on the tool (force_z < 0, towards the organ) a free probe does not feel; grasp =
+    false lets go."""
+    def pull(grasp):
+        fmu = slaves.initialised(settle=True)
+        t, z = 0.0, Z_OUT
+        while fmu.getInteger([vr["contact_count"]])[0] == 0 or z > Z_OUT - 0.035:
+            z -= 0.0005
+            fmu.setReal([vr["tool_pz"]], [z])
+            fmu.doStep(t, H)
+            t += H
+            assert z > Z_IN, "the probe never touched the organ"
+        fmu.setBoolean([vr["grasp"]], [grasp])
+        for _ in range(40):  # back out 2 cm at 5 cm/s
+            z += 0.0005
+            fmu.setReal([vr["tool_pz"]], [z])
+            fmu.doStep(t, H)
+            t += H
+        force_z = fmu.getReal([vr["force_z"]])[0]
+        held = fmu.getInteger([vr["grasped_count"]])[0]
+        return fmu, t, force_z, held
+
+    free_fmu, _, free_force, free_held = pull(False)
+    fmu, t, force, held = pull(True)
+    print(f"2 cm pulled back: grasped {held} particles, force_z {force:.3f} N "
+          f"(free probe: {free_force:.3f} N, {free_held} held)")
+    assert free_held == 0 and held > 0
+    assert force < -0.05, "the held tissue pulls the tool back towards the organ"
+    assert abs(free_force) < 0.1 * abs(force)
+    fmu.setBoolean([vr["grasp"]], [False])
+    for _ in range(20):
+        fmu.doStep(t, H)
+        t += H
+    assert fmu.getInteger([vr["grasped_count"]])[0] == 0
+    assert abs(fmu.getReal([vr["force_z"]])[0]) < 0.1 * abs(force)

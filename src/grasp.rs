@@ -1,0 +1,196 @@
+//! Grasping: a tool holds the tissue within its jaws through compliant attachment constraints.
+//!
+//! [`World::grasp`](crate::World::grasp) attaches every free particle within
+//! [`GraspOptions::reach`] of the tool's surface to the point of the tool frame where it is at
+//! that moment. Each substep, every attachment is projected towards its point on the moving tool
+//! as an XPBD constraint `C = p − T·a` (vector, `a` the anchor in the tool frame, `T` the tool's
+//! pose interpolated over the substep) with compliance `α` (m/N):
+//! `Δλ = −(C + α̃ λ) / (w + α̃)`, `α̃ = α / h²`, `Δp = w Δλ`. The particle's correction
+//! (times its mass) goes into the tool's wrench like a contact's, so the tool's force is the
+//! tissue's pull in N. When the attachments together pull on the tool with more than
+//! [`GraspOptions::max_force`] the tissue slips out of the jaws: every attachment is released.
+//! [`World::release`](crate::World::release) lets go; free contact with the tool then acts as
+//! before (anchors lie outside the tool, where contact put the particles, so holding and contact
+//! do not fight).
+
+use crate::body::Body;
+use crate::collision::tool::{Pose, Tool};
+use crate::error::{check_finite, Error};
+use crate::math::{Real, Vec3};
+use parry3d_f64::math::Point;
+
+/// How a tool grasps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GraspOptions {
+    /// Particles whose centre is within this distance (m) of the tool's surface (or inside it)
+    /// are grasped. `None`: 1.5 × the body's particle radius — the particles in contact (which
+    /// sit one particle radius from the surface) and none of the layer behind them.
+    pub reach: Option<Real>,
+    /// Compliance of each attachment (m/N; 0 = rigid). `None`: `1 / (E r)`, the compliance of a
+    /// cube of the body's tissue one particle radius `r` across (E its Young's modulus), so the
+    /// jaws hold as firmly as the tissue around them.
+    pub compliance: Option<Real>,
+    /// Largest total force (N) the attachments may exert on the tool; beyond it the tissue slips
+    /// and every attachment is released. Infinity (the default) never slips.
+    pub max_force: Real,
+}
+
+impl Default for GraspOptions {
+    fn default() -> Self {
+        GraspOptions {
+            reach: None,
+            compliance: None,
+            max_force: Real::INFINITY,
+        }
+    }
+}
+
+impl GraspOptions {
+    /// Check the options: `reach` and `compliance` finite and ≥ 0 when given, `max_force` > 0
+    /// (infinity allowed). NaN gives [`Error::NonFinite`], other bad values
+    /// [`Error::InvalidArgument`].
+    pub fn validate(&self) -> Result<(), Error> {
+        for (name, v) in [
+            ("grasp reach", self.reach),
+            ("grasp compliance", self.compliance),
+        ] {
+            if let Some(v) = v {
+                check_finite(name, v)?;
+                if v < 0.0 {
+                    return Err(Error::InvalidArgument(format!(
+                        "{name} must be >= 0, got {v}"
+                    )));
+                }
+            }
+        }
+        if self.max_force.is_nan() {
+            return Err(Error::NonFinite("grasp max_force is NaN".into()));
+        }
+        if self.max_force <= 0.0 {
+            return Err(Error::InvalidArgument(format!(
+                "grasp max_force must be > 0 N (infinity: never slips), got {}",
+                self.max_force
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One grasped particle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Attachment {
+    pub(crate) body: u32,
+    pub(crate) particle: u32,
+    /// Where the particle is held, in the tool's frame (m).
+    pub(crate) anchor: Vec3,
+    /// Compliance (m/N).
+    pub(crate) compliance: Real,
+    /// XPBD multiplier of the substep in progress (N·s²).
+    pub(crate) lambda: Vec3,
+}
+
+/// The attachments of one tool and its slip limit.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Grasp {
+    pub(crate) attachments: Vec<Attachment>,
+    pub(crate) max_force: Real,
+    /// Σ m Δx of the attachments over the step in progress (kg·m).
+    pub(crate) acc_impulse: Vec3,
+}
+
+impl Default for Grasp {
+    /// Not grasping.
+    fn default() -> Self {
+        Grasp {
+            attachments: Vec::new(),
+            max_force: Real::INFINITY,
+            acc_impulse: Vec3::zeros(),
+        }
+    }
+}
+
+impl Grasp {
+    /// The free particles of `bodies` within the options' reach of `tool` (at its current pose),
+    /// anchored where they are. Empty when nothing is within reach.
+    pub(crate) fn new(
+        tool: &Tool,
+        bodies: &[Body],
+        options: &GraspOptions,
+    ) -> Result<Grasp, Error> {
+        options.validate()?;
+        let iso = tool.pose.isometry();
+        let mut attachments = Vec::new();
+        for (b, body) in bodies.iter().enumerate() {
+            let reach = options.reach.unwrap_or(1.5 * body.particle_radius);
+            let compliance = options
+                .compliance
+                .unwrap_or(1.0 / (body.material.youngs_modulus * body.particle_radius));
+            let limit = tool.bounding_radius + reach;
+            for (i, x) in body.x.iter().enumerate() {
+                if body.inv_mass[i] == 0.0 || (x - tool.pose.position).norm() > limit {
+                    continue;
+                }
+                let d = tool.shape.distance_to_point(&iso, &Point::from(*x), true);
+                if d <= reach {
+                    attachments.push(Attachment {
+                        body: b as u32,
+                        particle: i as u32,
+                        anchor: iso.inverse_transform_point(&Point::from(*x)).coords,
+                        compliance,
+                        lambda: Vec3::zeros(),
+                    });
+                }
+            }
+        }
+        Ok(Grasp {
+            attachments,
+            max_force: options.max_force,
+            acc_impulse: Vec3::zeros(),
+        })
+    }
+
+    /// Start a substep: the XPBD multipliers restart from zero.
+    pub(crate) fn begin_substep(&mut self) {
+        self.attachments
+            .iter_mut()
+            .for_each(|a| a.lambda = Vec3::zeros());
+    }
+
+    /// One projection pass of every attachment towards the tool at pose `cur` for a substep `h`
+    /// (s); the particles' corrections (times their masses) go into `tool`'s wrench
+    /// accumulators and this grasp's own.
+    pub(crate) fn project(&mut self, tool: &mut Tool, bodies: &mut [Body], cur: &Pose, h: Real) {
+        let iso = cur.isometry();
+        for a in &mut self.attachments {
+            let body = &mut bodies[a.body as usize];
+            let i = a.particle as usize;
+            let w = body.inv_mass[i];
+            if w == 0.0 {
+                continue;
+            }
+            let target = iso.transform_point(&Point::from(a.anchor)).coords;
+            let c = body.p[i] - target;
+            let alpha = a.compliance / (h * h);
+            let dl = -(c + a.lambda * alpha) / (w + alpha);
+            a.lambda += dl;
+            let dp = dl * w;
+            body.p[i] += dp;
+            let impulse = dp * body.inertial_mass[i];
+            tool.acc_impulse += impulse;
+            tool.acc_moment += (target - cur.position).cross(&impulse);
+            self.acc_impulse += impulse;
+        }
+    }
+
+    /// End a step of `n` substeps of length `h` (s): release everything when the attachments'
+    /// mean force over the step exceeded the slip limit. Returns true if the tissue slipped.
+    pub(crate) fn end_step(&mut self, h: Real, n: u32) -> bool {
+        let force = self.acc_impulse.norm() / (h * h * n as Real);
+        self.acc_impulse = Vec3::zeros();
+        if force > self.max_force {
+            self.attachments.clear();
+            return true;
+        }
+        false
+    }
+}
