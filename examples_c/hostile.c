@@ -20,21 +20,8 @@
 
 #include "tissuesim.h"
 
-static int passed, failed;
+#include "check.h"
 
-#define CHECK(cond)                                                                                \
-    do {                                                                                           \
-        if (cond) {                                                                                \
-            passed++;                                                                              \
-        } else {                                                                                   \
-            failed++;                                                                              \
-            char m_[512];                                                                          \
-            ts_last_error_message(m_, sizeof m_);                                                  \
-            fprintf(stderr, "%s:%d: CHECK failed: %s (last error: %s)\n", __FILE__, __LINE__,     \
-                    #cond, m_);                                                                    \
-        }                                                                                          \
-    } while (0)
-#define CHECK_OK(call) CHECK((call) == TS_STATUS_OK)
 /* `call` (evaluated once) is refused with a status other than TS_STATUS_PANIC. */
 static int refused(ts_status st) { return st != TS_STATUS_OK && st != TS_STATUS_PANIC; }
 #define CHECK_REFUSED(call) CHECK(refused(call))
@@ -311,6 +298,5 @@ int main(void) {
     hostile_numbers();
     hostile_states();
     concurrent_worlds();
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
+    return check_summary();
 }

@@ -15,31 +15,8 @@
 
 #include "tissuesim.h"
 
-static int passed, failed;
+#include "check.h"
 
-#define CHECK(cond)                                                                                \
-    do {                                                                                           \
-        if (cond) {                                                                                \
-            passed++;                                                                              \
-        } else {                                                                                   \
-            failed++;                                                                              \
-            char m_[512];                                                                          \
-            ts_last_error_message(m_, sizeof m_);                                                  \
-            fprintf(stderr, "%s:%d: CHECK failed: %s (last error: %s)\n", __FILE__, __LINE__,     \
-                    #cond, m_);                                                                    \
-        }                                                                                          \
-    } while (0)
-
-/* `call` returns `expected`. */
-#define CHECK_ST(call, expected) CHECK((call) == (expected))
-#define CHECK_OK(call) CHECK_ST(call, TS_STATUS_OK)
-
-/* The thread's last error message contains `needle`. */
-static int last_error_has(const char *needle) {
-    char msg[1024];
-    ts_last_error_message(msg, sizeof msg);
-    return strstr(msg, needle) != NULL;
-}
 
 /* A lattice of cells^3 cubes of edge h (m), 6 tets each, corner at (OX, 0, 0): away from the
  * default organ (centred on the origin, about 0.2 m across). */
@@ -709,6 +686,5 @@ int main(void) {
     remove(obj_path);
     remove(bad_path);
 
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed == 0 ? 0 : 1;
+    return check_summary();
 }

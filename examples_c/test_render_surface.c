@@ -14,28 +14,8 @@
 
 #include "tissuesim.h"
 
-static int passed, failed;
+#include "check.h"
 
-#define CHECK(cond)                                                                                \
-    do {                                                                                           \
-        if (cond) {                                                                                \
-            passed++;                                                                              \
-        } else {                                                                                   \
-            failed++;                                                                              \
-            char m_[512];                                                                          \
-            ts_last_error_message(m_, sizeof m_);                                                  \
-            fprintf(stderr, "%s:%d: CHECK failed: %s (last error: %s)\n", __FILE__, __LINE__,     \
-                    #cond, m_);                                                                    \
-        }                                                                                          \
-    } while (0)
-#define CHECK_ST(call, expected) CHECK((call) == (expected))
-#define CHECK_OK(call) CHECK_ST(call, TS_STATUS_OK)
-
-static int last_error_has(const char *needle) {
-    char msg[1024];
-    ts_last_error_message(msg, sizeof msg);
-    return strstr(msg, needle) != NULL;
-}
 
 /* A cube [0, 0.1]^3 m of 2 x 2 x 2 cells, 6 tetrahedra each (Kuhn split). */
 #define C 2
@@ -250,6 +230,5 @@ int main(int argc, char **argv) {
     remove(bad);
     remove(out_obj);
     remove(out_vtu);
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed == 0 ? 0 : 1;
+    return check_summary();
 }
