@@ -200,6 +200,17 @@ static void hostile_numbers(void) {
                 before = snapshot(w, &len);
             }
         }
+        /* grasp options: refused, or legal (0 = automatic, negative compliance = automatic,
+         * a huge reach grasps everything) and released again. */
+        for (int f = 0; f < 3; f++) {
+            ts_grasp_options g;
+            CHECK_OK(ts_grasp_options_default(&g));
+            if (f == 0) g.reach = v; else if (f == 1) g.compliance = v; else g.max_force = v;
+            uint32_t held = 0;
+            st = ts_tool_grasp(w, tool, &g, &held);
+            CHECK(st != TS_STATUS_PANIC);
+            if (st == TS_STATUS_OK) CHECK_OK(ts_tool_release(w, tool));
+        }
         CHECK(unchanged(w, before, len));
     }
     /* stale ids. */
@@ -209,6 +220,8 @@ static void hostile_numbers(void) {
     ts_pose p = {{0, 0, 0}, {1, 0, 0, 0}};
     CHECK(ts_tool_set_pose(w, tool + 1, &p) == TS_STATUS_UNKNOWN_TOOL);
     CHECK(ts_tool_set_pose(w, UINT32_MAX, &p) == TS_STATUS_UNKNOWN_TOOL);
+    CHECK(ts_tool_grasp(w, tool + 1, NULL, NULL) == TS_STATUS_UNKNOWN_TOOL);
+    CHECK(ts_tool_release(w, UINT32_MAX) == TS_STATUS_UNKNOWN_TOOL);
     /* short and huge lengths. */
     CHECK(ts_body_positions(w, body, x, 3 * NN - 1) == TS_STATUS_BUFFER_TOO_SMALL);
     CHECK(ts_world_add_body_from_arrays(w, nodes, SIZE_MAX, tets, NT, NULL, NULL, NULL) !=

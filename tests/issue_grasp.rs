@@ -224,3 +224,23 @@ fn bad_grasps_are_errors_and_an_empty_grasp_is_not() {
     w.remove_tool(t).unwrap();
     assert!(matches!(w.release(t), Err(Error::UnknownTool(_))));
 }
+
+#[test]
+fn grasping_is_bit_identical_for_any_thread_count() {
+    let run = |threads: u32| -> (Vec<Vec3>, Vec3) {
+        let (mut w, b, t) = scene();
+        let mut s = w.settings().clone();
+        s.threads = threads;
+        w.set_settings(s).unwrap();
+        w.grasp(t, &GraspOptions::default()).unwrap();
+        let start = w.tool(t).unwrap().pose().position;
+        for k in 0..300 {
+            let lift = Vec3::new(0.0, 1e-4 * k as Real, 0.0);
+            w.set_tool_pose(t, Pose::at(start + lift)).unwrap();
+            w.step().unwrap();
+        }
+        let force = w.tool(t).unwrap().wrench().force;
+        (w.body(b).unwrap().positions().to_vec(), force)
+    };
+    assert_eq!(run(1), run(2));
+}
