@@ -309,6 +309,69 @@ static void test_grasp(double h) {
     ts_world_free(world);
 }
 
+/* Needle insertion: a 1 mm capsule pushed down into the lattice (bottom face fixed) over a
+ * column of particles punctures it when the tissue pushes back with the puncture force, then
+ * carries friction x inserted length; options and shapes are checked. */
+static void test_needle(double h) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    uint32_t body = 99, needle = 99, ball = 99;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
+    double lo[3] = {OX - 1, -1, -1}, hi[3] = {OX + 1, 1e-9, 1};
+    CHECK_OK(ts_body_fix_box(world, body, lo, hi, NULL));
+    const double half = 0.05, r = 0.001, x = OX + h, z = h; /* over an interior column */
+    double tip = CELLS * h + 0.015;
+    /* Pointing down: a half turn about x (w = 0, x = 1). */
+    ts_pose pose = {{x, tip + half + r, z}, {0, 1, 0, 0}};
+    CHECK_OK(ts_world_add_tool_capsule(world, half, r, &pose, NULL, &needle));
+    ts_pose far = {{2, 2, 2}, {1, 0, 0, 0}};
+    CHECK_OK(ts_world_add_tool_sphere(world, 0.01, &far, NULL, &ball));
+    ts_needle_options o;
+    CHECK_OK(ts_needle_options_default(&o));
+    CHECK(o.puncture_force > 0 && o.friction_per_length >= 0 && o.reach == 0);
+    CHECK_ST(ts_needle_options_default(NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_tool_make_needle(world, ball, &o), TS_STATUS_INVALID_ARGUMENT);
+    o.puncture_force = NAN;
+    CHECK_ST(ts_tool_make_needle(world, needle, &o), TS_STATUS_NON_FINITE);
+    o.puncture_force = 0.1;
+    o.friction_per_length = -1;
+    CHECK_ST(ts_tool_make_needle(world, needle, &o), TS_STATUS_INVALID_ARGUMENT);
+    ts_needle_state st;
+    CHECK_ST(ts_tool_needle_state(world, needle, &st), TS_STATUS_INVALID_ARGUMENT);
+    o.friction_per_length = 2.0;
+    CHECK_OK(ts_tool_make_needle(world, needle, &o));
+    CHECK_ST(ts_tool_make_needle(world, 9, &o), TS_STATUS_UNKNOWN_TOOL);
+    CHECK_ST(ts_tool_needle_state(world, needle, NULL), TS_STATUS_NULL_PARAMETER);
+    double before = 0, at_puncture = -1;
+    ts_wrench w;
+    for (int s = 0; s < 700; s++) { /* 5 cm/s for 3.5 cm */
+        tip -= 5e-5;
+        pose.position[1] = tip + half + r;
+        CHECK_OK(ts_tool_set_pose(world, needle, &pose));
+        CHECK_OK(ts_world_step(world, NULL));
+        CHECK_OK(ts_tool_wrench(world, needle, &w));
+        CHECK_OK(ts_tool_needle_state(world, needle, &st));
+        double axial = w.force[1]; /* the tissue pushes the down-pointing needle up */
+        if (st.punctured && at_puncture < 0) {
+            at_puncture = axial;
+            CHECK(before < o.puncture_force);
+        }
+        before = axial;
+    }
+    double friction = o.friction_per_length * st.inserted_length;
+    printf("needle: punctured at %.4f N (threshold %.2f N); %.1f mm in, %u held, %.4f N "
+           "(friction x length %.4f N)\n",
+           at_puncture, o.puncture_force, 1e3 * st.inserted_length, st.held, w.force[1], friction);
+    CHECK(at_puncture >= o.puncture_force);
+    CHECK(st.punctured == 1 && st.held > 0 && st.inserted_length > 0.01);
+    CHECK(fabs(w.force[1] - friction) < 0.25 * friction);
+    ts_world_free(world);
+}
+
 int main(void) {
     long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
     if (steps < 2) steps = 2;
@@ -317,6 +380,7 @@ int main(void) {
     test_settle(h);
     test_coverage(h);
     test_grasp(h);
+    test_needle(h);
 
     /* ---- version, status strings, last error ---- */
     CHECK(ts_version() == TISSUESIM_VERSION);

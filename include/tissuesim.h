@@ -377,6 +377,44 @@ typedef struct ts_grasp_options {
     double max_force;
 } ts_grasp_options;
 
+/**
+ * How a needle punctures and holds the tissue. ts_needle_options_default gives 1 N, 20 N/m and
+ * automatic reach.
+ */
+typedef struct ts_needle_options {
+    /**
+     * Axial force (N, > 0) the tissue must exert on the tip for the needle to puncture it.
+     */
+    double puncture_force;
+    /**
+     * Axial friction per inserted length (N/m, >= 0) once punctured.
+     */
+    double friction_per_length;
+    /**
+     * Particles within this distance (m) of the inserted shaft's axis are held on it; 0 means
+     * automatic (the needle's radius plus 1.5 particle radii).
+     */
+    double reach;
+} ts_needle_options;
+
+/**
+ * Where a needle is: ts_tool_needle_state.
+ */
+typedef struct ts_needle_state {
+    /**
+     * 1 when the needle is in the tissue, else 0.
+     */
+    uint8_t punctured;
+    /**
+     * How far the tip is past the entry point along the shaft (m; 0 when not punctured).
+     */
+    double inserted_length;
+    /**
+     * Number of particles held on the shaft.
+     */
+    uint32_t held;
+} ts_needle_state;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1112,6 +1150,42 @@ enum ts_status ts_tool_release(struct ts_world *world, uint32_t tool);
 enum ts_status ts_tool_grasped_count(const struct ts_world *world,
                                      uint32_t tool,
                                      uint32_t *out_count);
+
+/**
+ * Write the default needle options into *out.
+ *
+ * # Safety
+ *
+ * `out` is NULL or writable.
+ */
+enum ts_status ts_needle_options_default(struct ts_needle_options *out);
+
+/**
+ * Make `tool` (a capsule or a cylinder: shaft along its local y axis, tip at local +y) a needle:
+ * it punctures the tissue when the tissue pushes back on its tip with `puncture_force`, then
+ * holds the tissue on its shaft with axial friction. `options` may be NULL (defaults). Another
+ * shape or a bad option gives TS_STATUS_INVALID_ARGUMENT (NaN: TS_STATUS_NON_FINITE); nothing
+ * changes on error.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `options` is NULL or readable.
+ */
+enum ts_status ts_tool_make_needle(struct ts_world *world,
+                                   uint32_t tool,
+                                   const struct ts_needle_options *options);
+
+/**
+ * The insertion state of needle `tool` into *out_state (TS_STATUS_INVALID_ARGUMENT if the tool
+ * is not a needle).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_state` is NULL or writable.
+ */
+enum ts_status ts_tool_needle_state(const struct ts_world *world,
+                                    uint32_t tool,
+                                    struct ts_needle_state *out_state);
 
 /**
  * Size in bytes of the state ts_world_save_state writes for the world as it is now (it

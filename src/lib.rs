@@ -35,6 +35,7 @@ pub mod ffi;
 pub mod grasp;
 pub(crate) mod math;
 pub mod mesh;
+pub mod needle;
 pub(crate) mod neighbours;
 pub(crate) mod parallel;
 pub mod render;
@@ -56,6 +57,7 @@ pub use collision::tool::{
 pub use error::Error;
 pub use grasp::GraspOptions;
 pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
+pub use needle::{NeedleOptions, NeedleState};
 pub use neighbours::MAX_NEIGHBOURS;
 pub use settings::{ContactMode, DivergenceLimits, Settings};
 pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World};

@@ -11,10 +11,11 @@
 //! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
 //! | per tool in the world (removed tools left out), in id order: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
 //! | then its grasp: slip force (N), attachment count, and per attachment body, particle, anchor in the tool frame (m), compliance (m/N) | f64, u32, (u32, u32, f64 × 4)… |
+//! | then its needle: punctured body (`u32::MAX`: none, or not a needle), entry point (m), hold count, and per hold particle, anchor in the tool frame (m) | u32, f64 × 3, u32, (u32, f64 × 3)… |
 //! | FNV-1a 64 checksum of everything before it | u64 |
 //!
 //! The scene itself (meshes, materials, fixed particles, settings) is not part of the state: a
-//! state restores into a world built the same way. Its size depends on the grasps in force
+//! state restores into a world built the same way. Its size depends on the grasps and needle holds in force
 //! ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
 
@@ -22,6 +23,7 @@ use crate::collision::tool::{Pose, Wrench};
 use crate::error::Error;
 use crate::grasp::{Attachment, Grasp};
 use crate::math::{is_finite_vec, Quat, Real, Vec3};
+use crate::needle::{Needle, ShaftHold};
 use crate::world::World;
 
 /// Version of the byte format written by [`World::save_state`].
@@ -30,11 +32,18 @@ pub const STATE_VERSION: u32 = 2;
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
 const HEADER: usize = 8 + 4 + 4 + 4 + 8;
 const TOOL_REALS: usize = 7 + 7 + 3 + 3 + 3 + 1;
-/// Bytes of a tool's fixed part: the reals, the contact count, the slip force, the attachment
-/// count.
-const TOOL_BYTES: usize = TOOL_REALS * 8 + 4 + 8 + 4;
-/// Bytes of one attachment: body, particle, anchor, compliance.
+/// Bytes of a tool's pose, velocity and wrench: the reals and the contact count.
+const TOOL_MOTION_BYTES: usize = TOOL_REALS * 8 + 4;
+/// Bytes of a tool's fixed part: motion, then the grasp's slip force and attachment count, then
+/// the needle's punctured body, entry point and hold count.
+const TOOL_BYTES: usize = TOOL_MOTION_BYTES + 8 + 4 + 4 + 3 * 8 + 4;
+/// Bytes of one grasp attachment: body, particle, anchor, compliance.
 const ATTACHMENT_BYTES: usize = 4 + 4 + 4 * 8;
+/// Bytes of one needle hold: particle, anchor.
+const HOLD_BYTES: usize = 4 + 3 * 8;
+/// The punctured-body field of a needle that is out of the tissue (or of a tool that is not a
+/// needle).
+const NO_BODY: u32 = u32::MAX;
 
 fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -113,17 +122,19 @@ impl World {
             + self.bodies.len() * 4
             + particles * 10 * 8
             + self.tool_count() * TOOL_BYTES
-            + self.attachment_count() * ATTACHMENT_BYTES
+            + self.tool_extras(|g, n| {
+                g.attachments.len() * ATTACHMENT_BYTES + n.map_or(0, |n| n.holds.len() * HOLD_BYTES)
+            })
             + 8
     }
 
-    /// Attachments of the grasps of the tools in the world.
-    fn attachment_count(&self) -> usize {
+    /// Σ `f(grasp, needle)` over the tools in the world.
+    fn tool_extras(&self, f: impl Fn(&Grasp, Option<&Needle>) -> usize) -> usize {
         self.tools
             .iter()
-            .zip(&self.grasps)
+            .zip(self.grasps.iter().zip(&self.needles))
             .filter(|(t, _)| t.is_some())
-            .map(|(_, g)| g.attachments.len())
+            .map(|(_, (g, n))| f(g, n.as_ref()))
             .sum()
     }
 
@@ -144,7 +155,7 @@ impl World {
             b.v.iter().for_each(|v| w.vec3(v));
             b.rotation.iter().for_each(|q| w.quat(q));
         }
-        for (t, g) in self.tools.iter().zip(&self.grasps) {
+        for (t, (g, needle)) in self.tools.iter().zip(self.grasps.iter().zip(&self.needles)) {
             let Some(t) = t else { continue };
             w.pose(&t.pose);
             w.pose(&t.target);
@@ -160,6 +171,22 @@ impl World {
                 w.u32(a.particle);
                 w.vec3(&a.anchor);
                 w.f64(a.compliance);
+            }
+            match needle {
+                Some(n) => {
+                    w.u32(n.body.unwrap_or(NO_BODY));
+                    w.vec3(&n.entry);
+                    w.u32(n.holds.len() as u32);
+                    for h in &n.holds {
+                        w.u32(h.particle);
+                        w.vec3(&h.anchor);
+                    }
+                }
+                None => {
+                    w.u32(NO_BODY);
+                    w.vec3(&Vec3::zeros());
+                    w.u32(0);
+                }
             }
         }
         let sum = fnv1a(&out[start..]);
@@ -192,7 +219,7 @@ impl World {
         if fnv1a(&bytes[..body_len]) != sum {
             return bad("checksum mismatch (corrupted state)");
         }
-        let grasps = self.read_grasps(bytes)?;
+        let extras = self.read_tool_extras(bytes)?;
         // Check particle counts and finiteness before changing anything.
         let mut check = Reader { bytes, at: HEADER };
         for b in &self.bodies {
@@ -228,13 +255,13 @@ impl World {
                 return bad("non-finite particle rotation");
             }
         }
-        for g in &grasps {
+        for extra in &extras {
             let head_finite = (0..TOOL_REALS - 1).all(|_| scan.f64().is_finite());
             scan.at += 4;
             if !head_finite || !scan.f64().is_finite() {
                 return bad("non-finite tool state");
             }
-            scan.at += 12 + g.attachments.len() * ATTACHMENT_BYTES;
+            scan.at += extra.bytes;
         }
         // Everything checked: apply.
         r.at = HEADER - 8;
@@ -245,8 +272,9 @@ impl World {
             b.v.iter_mut().for_each(|v| *v = r.vec3());
             b.rotation.iter_mut().for_each(|q| *q = r.quat());
         }
-        let mut grasps = grasps.into_iter();
-        for (t, g) in self.tools.iter_mut().zip(&mut self.grasps) {
+        let mut extras = extras.into_iter();
+        let slots = self.grasps.iter_mut().zip(&mut self.needles);
+        for (t, (g, needle)) in self.tools.iter_mut().zip(slots) {
             let Some(t) = t else { continue };
             t.pose = r.pose();
             t.target = r.pose();
@@ -261,40 +289,51 @@ impl World {
                 contact_count,
                 max_penetration,
             };
-            *g = grasps.next().unwrap_or_default();
-            r.at += 12 + g.attachments.len() * ATTACHMENT_BYTES;
+            let Some(extra) = extras.next() else { break };
+            r.at += extra.bytes;
+            *g = extra.grasp;
+            if let Some(n) = needle {
+                (n.body, n.entry, n.holds) = extra.needle;
+            }
         }
         Ok(())
     }
 
-    /// The grasps of a state whose header, counts and checksum were checked, one per tool in the
-    /// world, after checking the state's length against the attachment counts it declares and
-    /// every attachment against this world (body, particle, finite anchor, compliance ≥ 0).
-    fn read_grasps(&self, bytes: &[u8]) -> Result<Vec<Grasp>, Error> {
+    /// The grasps and needle states of a state whose header, counts and checksum were checked,
+    /// one per tool in the world, after checking the state's length against the counts it
+    /// declares and every attachment and hold against this world (body, particle, finite
+    /// anchor, compliance ≥ 0, needle state only for needles).
+    fn read_tool_extras(&self, bytes: &[u8]) -> Result<Vec<ToolExtras>, Error> {
         let bad = |m: String| Err(Error::BadState(m));
         let mut at = HEADER;
         for b in &self.bodies {
             at += 4 + b.particle_count() * 10 * 8;
         }
-        let mut grasps = Vec::with_capacity(self.tool_count());
-        for _ in 0..self.tool_count() {
-            if at + TOOL_BYTES + 8 > bytes.len() {
+        let particle_of = |body: u32, particle: u32| {
+            self.bodies
+                .get(body as usize)
+                .is_some_and(|b| (particle as usize) < b.particle_count())
+        };
+        let mut out = Vec::with_capacity(self.tool_count());
+        for (_, needle) in self
+            .tools
+            .iter()
+            .zip(&self.needles)
+            .filter(|(t, _)| t.is_some())
+        {
+            let start = at + TOOL_MOTION_BYTES;
+            let fits = |end: Option<usize>| end.is_some_and(|end| end + 8 <= bytes.len());
+            if !fits(Some(at + TOOL_BYTES)) {
                 return bad(format!(
                     "state is {} bytes: too short for this world",
                     bytes.len()
                 ));
             }
-            let mut r = Reader {
-                bytes,
-                at: at + TOOL_BYTES - 12,
-            };
+            let mut r = Reader { bytes, at: start };
             let max_force = r.f64();
             let count = r.u32() as usize;
-            at += TOOL_BYTES;
-            let end = count
-                .checked_mul(ATTACHMENT_BYTES)
-                .and_then(|n| n.checked_add(at + 8));
-            if !end.is_some_and(|end| end <= bytes.len()) {
+            let grasp_end = count.checked_mul(ATTACHMENT_BYTES).map(|n| n + r.at);
+            if !fits(grasp_end.map(|e| e + TOOL_BYTES - TOOL_MOTION_BYTES - 12)) {
                 return bad(format!(
                     "state declares {count} grasped particles beyond its end"
                 ));
@@ -306,12 +345,8 @@ impl World {
             for _ in 0..count {
                 let (body, particle) = (r.u32(), r.u32());
                 let (anchor, compliance) = (r.vec3(), r.f64());
-                let known = self
-                    .bodies
-                    .get(body as usize)
-                    .is_some_and(|b| (particle as usize) < b.particle_count());
-                if !(known && is_finite_vec(&anchor) && compliance >= 0.0 && compliance.is_finite())
-                {
+                let ok = compliance >= 0.0 && compliance.is_finite();
+                if !(particle_of(body, particle) && is_finite_vec(&anchor) && ok) {
                     return bad(format!(
                         "grasped particle {particle} of body {body}: unknown or non-finite"
                     ));
@@ -324,12 +359,44 @@ impl World {
                     lambda: Vec3::zeros(),
                 });
             }
-            at = r.at;
-            grasps.push(Grasp {
-                attachments,
-                max_force,
-                acc_impulse: Vec3::zeros(),
+            let (body, entry, holds) = (r.u32(), r.vec3(), r.u32() as usize);
+            if !fits(holds.checked_mul(HOLD_BYTES).map(|n| n + r.at)) {
+                return bad(format!(
+                    "state declares {holds} needle holds beyond its end"
+                ));
+            }
+            let punctured = (body != NO_BODY).then_some(body);
+            if (needle.is_none() && (punctured.is_some() || holds > 0))
+                || punctured.is_some_and(|b| b as usize >= self.bodies.len())
+                || !is_finite_vec(&entry)
+            {
+                return bad(format!("needle state (body {body}) does not fit this tool"));
+            }
+            let mut held = Vec::with_capacity(holds);
+            for _ in 0..holds {
+                let (particle, anchor) = (r.u32(), r.vec3());
+                if !(punctured.is_some_and(|b| particle_of(b, particle)) && is_finite_vec(&anchor))
+                {
+                    return bad(format!(
+                        "needle hold of particle {particle}: unknown or non-finite"
+                    ));
+                }
+                held.push(ShaftHold {
+                    particle,
+                    anchor,
+                    lambda: Vec3::zeros(),
+                });
+            }
+            out.push(ToolExtras {
+                bytes: r.at - start,
+                grasp: Grasp {
+                    attachments,
+                    max_force,
+                    acc_impulse: Vec3::zeros(),
+                },
+                needle: (punctured, entry, held),
             });
+            at = r.at;
         }
         if at + 8 != bytes.len() {
             return bad(format!(
@@ -338,6 +405,15 @@ impl World {
                 at + 8
             ));
         }
-        Ok(grasps)
+        Ok(out)
     }
+}
+
+/// What a state holds of a tool beyond its motion and wrench.
+struct ToolExtras {
+    /// Length of this part in the state (bytes).
+    bytes: usize,
+    grasp: Grasp,
+    /// Punctured body, entry point (m), held particles.
+    needle: (Option<u32>, Vec3, Vec<ShaftHold>),
 }

@@ -26,6 +26,7 @@ use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
+use crate::needle::{Needle, NeedleOptions, NeedleState};
 use crate::parallel::Pool;
 use crate::render::{RenderMesh, RenderSurface};
 use crate::settings::{ContactMode, Settings};
@@ -68,6 +69,8 @@ pub struct World {
     pub(crate) tools: Vec<Option<Tool>>,
     /// The grasp of each tool, by tool id (no attachments: not grasping).
     pub(crate) grasps: Vec<Grasp>,
+    /// The needle of each tool, by tool id (`None`: not a needle).
+    pub(crate) needles: Vec<Option<Needle>>,
     render_surfaces: Vec<RenderSurface>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
@@ -86,6 +89,7 @@ impl World {
             bodies: Vec::new(),
             tools: Vec::new(),
             grasps: Vec::new(),
+            needles: Vec::new(),
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             grid: HashGrid::default(),
@@ -282,6 +286,7 @@ impl World {
         self.tools
             .push(Some(Tool::new(shape, pose, options, spacing)?));
         self.grasps.push(Grasp::default());
+        self.needles.push(None);
         Ok(ToolId(id))
     }
     /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
@@ -291,7 +296,30 @@ impl World {
         self.tool(id)?;
         self.tools[id.0 as usize] = None;
         self.grasps[id.0 as usize] = Grasp::default();
+        self.needles[id.0 as usize] = None;
         Ok(())
+    }
+    /// Make tool `id` (a capsule or a cylinder: the shaft along local y, the tip at local +y) a
+    /// needle: it punctures the tissue when the tissue pushes back on its tip with the puncture
+    /// force, then holds the tissue on its shaft with axial friction (see [`crate::needle`]).
+    /// Nothing changes on error.
+    pub fn make_needle(&mut self, id: ToolId, options: &NeedleOptions) -> Result<(), Error> {
+        let needle = Needle::new(self.tool(id)?, *options)?;
+        self.needles[id.0 as usize] = Some(needle);
+        Ok(())
+    }
+    /// The insertion state of needle `id` ([`Error::InvalidArgument`] if the tool is not a
+    /// needle).
+    pub fn needle_state(&self, id: ToolId) -> Result<NeedleState, Error> {
+        let tool = self.tool(id)?;
+        let needle = self.needles[id.0 as usize]
+            .as_ref()
+            .ok_or_else(|| Error::InvalidArgument(format!("tool {} is not a needle", id.0)))?;
+        Ok(NeedleState {
+            punctured: needle.body.is_some(),
+            inserted_length: needle.inserted_length(&tool.pose).max(0.0),
+            held: needle.holds.len(),
+        })
     }
     /// Grasp with tool `id`: every free particle within [`GraspOptions::reach`] of the tool's
     /// surface is attached, where it is now, to the tool (compliant attachment constraints, see
@@ -555,6 +583,11 @@ impl World {
             t.linear_velocity = (t.target.position - t.pose.position) / dt;
             t.pose = t.target;
         }
+        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
+            if let (Some(tool), Some(needle)) = (tool, needle) {
+                needle.end_step(tool, &self.bodies);
+            }
+        }
         self.time += dt;
         Ok(StepReport {
             substeps: n,
@@ -585,8 +618,14 @@ impl World {
             t.acc_contacts = 0;
         }
         self.grasps.iter_mut().for_each(Grasp::begin_substep);
-        let s_prev = (k - 1) as Real / n as Real;
         let s_cur = k as Real / n as Real;
+        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
+            if let (Some(tool), Some(needle)) = (tool, needle) {
+                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                needle.begin_substep(&self.bodies, &cur);
+            }
+        }
+        let s_prev = (k - 1) as Real / n as Real;
         for it in 0..self.settings.iterations {
             if self.settings.volume_constraints {
                 for body in &mut self.bodies {
@@ -598,10 +637,14 @@ impl World {
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;
-            for tool in self.tools.iter_mut().flatten() {
+            for (tool, needle) in self.tools.iter_mut().zip(&self.needles) {
+                let Some(tool) = tool else { continue };
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                for body in &mut self.bodies {
+                for (b, body) in self.bodies.iter_mut().enumerate() {
+                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) {
+                        continue;
+                    }
                     let motion = (&prev, &cur);
                     project_tool_contacts(tool, body, motion, mode, max_correction, it == 0);
                 }
@@ -612,6 +655,12 @@ impl World {
                         let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                         grasp.project(tool, &mut self.bodies, &cur, h);
                     }
+                }
+            }
+            for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
+                if let (Some(tool), Some(needle)) = (tool, needle) {
+                    let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                    needle.project(tool, &mut self.bodies, &cur, h);
                 }
             }
         }

@@ -1,0 +1,290 @@
+//! Needle insertion: a capsule or cylinder tool that punctures the tissue when the force at its
+//! tip exceeds a threshold, then holds the tissue on its shaft with axial friction.
+//!
+//! A tool becomes a needle with [`World::make_needle`](crate::World::make_needle); its shaft is
+//! the tool's local y axis and its tip the end at local +y. Before puncture it is an ordinary
+//! tool: contact pushes the tissue. At the end of a step, when the tissue pushes back against the
+//! tip along the shaft with at least [`NeedleOptions::puncture_force`] (N), the needle punctures
+//! the body nearest its tip: from then on contact between the needle and that body is off, and
+//! every free particle of the body that comes within [`NeedleOptions::reach`] of the inserted
+//! part of the shaft (from the entry point, where the tip was at puncture, to the tip) is held
+//! on the shaft:
+//!
+//! - laterally, at its offset from the axis in the needle's frame (an XPBD constraint of
+//!   compliance `1/(E r)` as for grasping), so the tissue moves with the shaft sideways;
+//! - axially with friction: the particle sticks to its axial position on the shaft while the
+//!   force that takes is below its share of `friction_per_length × inserted length`, and slips
+//!   along the shaft with that force otherwise (position-level Coulomb friction, like the
+//!   contact friction of PBD).
+//!
+//! The axial force on the needle therefore shows the classic profile: a rise while the tip
+//! indents the surface, a drop at puncture, and a growth with the inserted length. Particles that
+//! the tip withdraws past are let go; once the tip is back behind the entry point the needle is
+//! out and contact acts again.
+
+use crate::body::Body;
+use crate::collision::tool::{Pose, Tool, ToolShape};
+use crate::error::{check_finite, Error};
+use crate::math::{Real, Vec3};
+use parry3d_f64::math::Point;
+
+/// How a needle punctures and holds the tissue.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NeedleOptions {
+    /// Axial force (N) the tissue must exert on the tip for the needle to puncture it (a
+    /// property of the tissue and the needle; liver and a 1 mm needle: ~0.5–1.5 N).
+    pub puncture_force: Real,
+    /// Axial friction force per inserted length (N/m) once punctured.
+    pub friction_per_length: Real,
+    /// Particles whose centre comes within this distance (m) of the inserted shaft's axis are
+    /// held. `None`: the needle's radius plus 1.5 particle radii (the particles contact had
+    /// placed around it).
+    pub reach: Option<Real>,
+}
+
+impl Default for NeedleOptions {
+    fn default() -> Self {
+        NeedleOptions {
+            puncture_force: 1.0,
+            friction_per_length: 20.0,
+            reach: None,
+        }
+    }
+}
+
+impl NeedleOptions {
+    /// Check the options: `puncture_force` > 0, `friction_per_length` ≥ 0, `reach` > 0 when
+    /// given; all finite ([`Error::NonFinite`] otherwise).
+    pub fn validate(&self) -> Result<(), Error> {
+        check_finite("needle puncture_force", self.puncture_force)?;
+        check_finite("needle friction_per_length", self.friction_per_length)?;
+        let bad = |m: String| Err(Error::InvalidArgument(m));
+        if self.puncture_force <= 0.0 {
+            return bad(format!(
+                "needle puncture_force must be > 0 N, got {}",
+                self.puncture_force
+            ));
+        }
+        if self.friction_per_length < 0.0 {
+            return bad(format!(
+                "needle friction_per_length must be >= 0 N/m, got {}",
+                self.friction_per_length
+            ));
+        }
+        if let Some(r) = self.reach {
+            check_finite("needle reach", r)?;
+            if r <= 0.0 {
+                return bad(format!("needle reach must be > 0 m, got {r}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where a needle is: [`World::needle_state`](crate::World::needle_state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NeedleState {
+    /// Whether the needle is in the tissue.
+    pub punctured: bool,
+    /// How far the tip is past the entry point along the shaft (m; 0 when not punctured).
+    pub inserted_length: Real,
+    /// Number of particles held on the shaft.
+    pub held: usize,
+}
+
+/// One particle held on the shaft.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ShaftHold {
+    pub(crate) particle: u32,
+    /// Where the particle is held, in the needle's frame (m): x and z lateral, y axial.
+    pub(crate) anchor: Vec3,
+    /// XPBD multiplier of the lateral constraint, this substep (N·s²).
+    pub(crate) lambda: Vec3,
+}
+
+/// The needle state of a tool.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Needle {
+    pub(crate) options: NeedleOptions,
+    /// Distance (m) from the tool origin to the tip along local +y.
+    pub(crate) tip: Real,
+    /// Radius of the shaft (m).
+    pub(crate) radius: Real,
+    /// The punctured body, if any.
+    pub(crate) body: Option<u32>,
+    /// Where the tip entered the tissue (m, world frame).
+    pub(crate) entry: Vec3,
+    pub(crate) holds: Vec<ShaftHold>,
+}
+
+impl Needle {
+    /// A needle made of `tool`, which must be a capsule or a cylinder.
+    pub(crate) fn new(tool: &Tool, options: NeedleOptions) -> Result<Needle, Error> {
+        options.validate()?;
+        let (tip, radius) = match tool.description {
+            ToolShape::Capsule {
+                half_height,
+                radius,
+            } => (half_height + radius, radius),
+            ToolShape::Cylinder {
+                half_height,
+                radius,
+            } => (half_height, radius),
+            _ => {
+                return Err(Error::InvalidArgument(
+                    "a needle is a capsule or a cylinder tool (shaft along local y)".into(),
+                ))
+            }
+        };
+        Ok(Needle {
+            options,
+            tip,
+            radius,
+            body: None,
+            entry: Vec3::zeros(),
+            holds: Vec::new(),
+        })
+    }
+
+    /// Unit shaft direction (world frame) at `pose`.
+    fn axis(pose: &Pose) -> Vec3 {
+        pose.orientation * Vec3::y()
+    }
+
+    /// The tip (m, world frame) at `pose`.
+    fn tip_at(&self, pose: &Pose) -> Vec3 {
+        pose.position + Self::axis(pose) * self.tip
+    }
+
+    /// Inserted length (m) at `pose`: how far the tip is past the entry point along the shaft.
+    pub(crate) fn inserted_length(&self, pose: &Pose) -> Real {
+        match self.body {
+            Some(_) => (self.tip_at(pose) - self.entry).dot(&Self::axis(pose)),
+            None => 0.0,
+        }
+    }
+
+    /// Whether contact between this needle and body `b` is off (punctured).
+    pub(crate) fn passes_through(&self, b: usize) -> bool {
+        self.body == Some(b as u32)
+    }
+
+    /// At the end of a step: puncture when the tissue pushes back on the tip along the shaft
+    /// with at least the puncture force (the body nearest the tip is punctured); pull out when
+    /// the tip is back behind the entry point.
+    pub(crate) fn end_step(&mut self, tool: &Tool, bodies: &[Body]) {
+        let pose = tool.pose;
+        match self.body {
+            None => {
+                let resisting = -tool.wrench.force.dot(&Self::axis(&pose));
+                if tool.wrench.contact_count == 0 || resisting < self.options.puncture_force {
+                    return;
+                }
+                let tip = self.tip_at(&pose);
+                let nearest = bodies
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(b, body)| {
+                        body.x
+                            .iter()
+                            .map(|x| (x - tip).norm())
+                            .min_by(Real::total_cmp)
+                            .map(|d| (d, b))
+                    })
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                if let Some((_, b)) = nearest {
+                    self.body = Some(b as u32);
+                    self.entry = tip;
+                }
+            }
+            Some(_) => {
+                if self.inserted_length(&pose) <= 0.0 {
+                    self.body = None;
+                    self.holds.clear();
+                }
+            }
+        }
+    }
+
+    /// Start a substep at needle pose `cur`: hold the particles newly within reach of the
+    /// inserted shaft, let go of those the tip withdrew past, restart the multipliers.
+    pub(crate) fn begin_substep(&mut self, bodies: &[Body], cur: &Pose) {
+        let Some(b) = self.body else { return };
+        let body = &bodies[b as usize];
+        let iso = cur.isometry();
+        let length = self.inserted_length(cur);
+        let (top, bottom) = (self.tip, self.tip - length.max(0.0));
+        let reach = self
+            .options
+            .reach
+            .unwrap_or(self.radius + 1.5 * body.particle_radius);
+        self.holds.retain(|h| h.anchor.y <= top);
+        for h in &mut self.holds {
+            h.lambda = Vec3::zeros();
+        }
+        for (i, x) in body.x.iter().enumerate() {
+            if body.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let local = iso.inverse_transform_point(&Point::from(*x)).coords;
+            let lateral = (local.x * local.x + local.z * local.z).sqrt();
+            if lateral > reach || local.y > top || local.y < bottom {
+                continue;
+            }
+            if self.holds.iter().any(|h| h.particle == i as u32) {
+                continue;
+            }
+            self.holds.push(ShaftHold {
+                particle: i as u32,
+                anchor: local,
+                lambda: Vec3::zeros(),
+            });
+        }
+    }
+
+    /// One projection pass of the held particles towards the shaft at pose `cur` for a substep
+    /// `h` (s): lateral XPBD constraints and axial stick-or-slip friction; the corrections
+    /// (times the particles' masses) go into `tool`'s wrench accumulators.
+    pub(crate) fn project(&mut self, tool: &mut Tool, bodies: &mut [Body], cur: &Pose, h: Real) {
+        let Some(b) = self.body else { return };
+        let body = &mut bodies[b as usize];
+        if self.holds.is_empty() {
+            return;
+        }
+        let iso = cur.isometry();
+        let axis = Self::axis(cur);
+        let compliance = 1.0 / (body.material.youngs_modulus * body.particle_radius);
+        let alpha = compliance / (h * h);
+        // Each held particle's share of the friction force (N).
+        let length = self.inserted_length(cur).max(0.0);
+        let share = self.options.friction_per_length * length / self.holds.len() as Real;
+        for hold in &mut self.holds {
+            let i = hold.particle as usize;
+            let w = body.inv_mass[i];
+            if w == 0.0 {
+                continue;
+            }
+            let before = body.p[i];
+            let local = iso.inverse_transform_point(&Point::from(before)).coords;
+            // Lateral: towards the anchor's offset from the axis (local x, z).
+            let c = Vec3::new(local.x - hold.anchor.x, 0.0, local.z - hold.anchor.z);
+            let dl = -(c + hold.lambda * alpha) / (w + alpha);
+            hold.lambda += dl;
+            let lateral_world = cur.orientation * (dl * w);
+            // Axial: stick if the force that takes is within the share, else slip with it.
+            let m = body.inertial_mass[i];
+            let stick = hold.anchor.y - local.y;
+            let limit = share * h * h / m;
+            let axial = stick.clamp(-limit, limit);
+            if axial != stick {
+                hold.anchor.y = local.y + axial;
+            }
+            let dp = lateral_world + axis * axial;
+            body.p[i] += dp;
+            let impulse = dp * m;
+            tool.acc_impulse += impulse;
+            let at = iso.transform_point(&Point::from(hold.anchor)).coords;
+            tool.acc_moment += (at - cur.position).cross(&impulse);
+        }
+    }
+}
