@@ -372,6 +372,55 @@ static void test_needle(double h) {
     ts_world_free(world);
 }
 
+/* Cutting: a horizontal blade swept through the middle of the lattice (bottom face fixed)
+ * cuts it in two; the top half then falls under gravity. A capsule becomes a blade tool. */
+static void test_cut(double h) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    uint32_t body = 99, blade = 99, ball = 99;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
+    double lo[3] = {OX - 1, -1, -1}, hi[3] = {OX + 1, 1e-9, 1};
+    CHECK_OK(ts_body_fix_box(world, body, lo, hi, NULL));
+    double y = 1.5 * h; /* between the second and third layers of nodes */
+    double from[6] = {OX - 0.05, y, -0.05, OX - 0.05, y, CELLS * h + 0.05};
+    double to[6] = {OX + CELLS * h + 0.05, y, -0.05, OX + CELLS * h + 0.05, y, CELLS * h + 0.05};
+    ts_cut_report report = {0, 0, 0};
+    uint64_t pairs = 9, removed = 9;
+    CHECK_OK(ts_body_cut_counts(world, body, &pairs, &removed));
+    CHECK(pairs == 0 && removed == 0);
+    from[1] = NAN;
+    CHECK_ST(ts_world_cut(world, body, from, to, &report), TS_STATUS_NON_FINITE);
+    from[1] = y;
+    CHECK_ST(ts_world_cut(world, body, NULL, to, &report), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_world_cut(world, 9, from, to, &report), TS_STATUS_UNKNOWN_BODY);
+    CHECK(report.pairs == 0); /* outputs only on success */
+    CHECK_OK(ts_world_cut(world, body, from, to, &report));
+    CHECK(report.pairs > 0 && report.tets > 0);
+    CHECK_OK(ts_body_cut_counts(world, body, &pairs, &removed));
+    CHECK(pairs == report.pairs && removed == report.tets);
+    CHECK_ST(ts_body_cut_counts(world, body, NULL, &removed), TS_STATUS_NULL_PARAMETER);
+    for (int s = 0; s < 100; s++) CHECK_OK(ts_world_step(world, NULL));
+    double x[3 * NN];
+    CHECK_OK(ts_body_positions(world, body, x, 3 * NN));
+    double fall = 0;
+    for (int i = 0; i <= CELLS; i++)
+        for (int k = 0; k <= CELLS; k++) fall += (CELLS * h - x[3 * node_id(i, CELLS, k) + 1]) / 16;
+    printf("cut: %llu pairs, %llu tets; the top half fell %.1f mm in 0.1 s\n",
+           (unsigned long long)report.pairs, (unsigned long long)report.tets, 1e3 * fall);
+    CHECK(fall > 0.02); /* free fall: 49 mm in 0.1 s */
+    ts_pose far = {{2, 2, 2}, {1, 0, 0, 0}};
+    CHECK_OK(ts_world_add_tool_capsule(world, 0.05, 0.0005, &far, NULL, &blade));
+    CHECK_OK(ts_tool_make_blade(world, blade));
+    CHECK_OK(ts_world_add_tool_sphere(world, 0.01, &far, NULL, &ball));
+    CHECK_ST(ts_tool_make_blade(world, ball), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_tool_make_blade(world, 9), TS_STATUS_UNKNOWN_TOOL);
+    ts_world_free(world);
+}
+
 int main(void) {
     long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
     if (steps < 2) steps = 2;
@@ -381,6 +430,7 @@ int main(void) {
     test_coverage(h);
     test_grasp(h);
     test_needle(h);
+    test_cut(h);
 
     /* ---- version, status strings, last error ---- */
     CHECK(ts_version() == TISSUESIM_VERSION);

@@ -415,6 +415,24 @@ typedef struct ts_needle_state {
     uint32_t held;
 } ts_needle_state;
 
+/**
+ * What a cut removed.
+ */
+typedef struct ts_cut_report {
+    /**
+     * Neighbour pairs cut.
+     */
+    uint64_t pairs;
+    /**
+     * Tetrahedra removed.
+     */
+    uint64_t tets;
+    /**
+     * Particles left without elasticity (too few neighbours).
+     */
+    uint64_t isolated;
+} ts_cut_report;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1186,6 +1204,48 @@ enum ts_status ts_tool_make_needle(struct ts_world *world,
 enum ts_status ts_tool_needle_state(const struct ts_world *world,
                                     uint32_t tool,
                                     struct ts_needle_state *out_state);
+
+/**
+ * Cut `body` now with a blade whose edge runs from `from[0..3]` to `from[3..6]` at the start
+ * of its motion and from `to[0..3]` to `to[3..6]` at its end (m, world frame): the neighbour
+ * pairs and tetrahedra crossed by the swept surface are removed. What was removed goes to
+ * *out_report when `out_report` is not NULL. NaN/Inf give TS_STATUS_NON_FINITE; nothing
+ * changes on error.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `from` and `to` are NULL or point to 6 readable doubles;
+ * `out_report` is NULL or writable.
+ */
+enum ts_status ts_world_cut(struct ts_world *world,
+                            uint32_t body,
+                            const double *from,
+                            const double *to,
+                            struct ts_cut_report *out_report);
+
+/**
+ * Make `tool` (a capsule or a cylinder) a blade: its edge is the segment of its local y axis
+ * between +-half_height; at the end of every step it cuts every body along the surface its
+ * edge swept, and it does not push the tissue. Another shape gives TS_STATUS_INVALID_ARGUMENT.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_tool_make_blade(struct ts_world *world, uint32_t tool);
+
+/**
+ * The neighbour pairs cut and tetrahedra removed from `body` so far into *out_pairs and
+ * *out_tets.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_pairs` and `out_tets` are NULL or writable.
+ */
+enum ts_status ts_body_cut_counts(const struct ts_world *world,
+                                  uint32_t body,
+                                  uint64_t *out_pairs,
+                                  uint64_t *out_tets);
 
 /**
  * Size in bytes of the state ts_world_save_state writes for the world as it is now (it

@@ -253,6 +253,8 @@ pub struct Body {
     /// XPBD multipliers of the volume constraints within a substep; scratch.
     pub(crate) tet_lambda: Vec<Real>,
     pub(crate) boundary: Vec<[u32; 3]>,
+    /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
+    pub(crate) cuts: Option<Box<crate::cut::CutState>>,
     pub(crate) particle_radius: Real,
     /// Centre of the rest bounding box (m).
     pub(crate) rest_centre: Vec3,
@@ -351,6 +353,7 @@ impl Body {
             tet_rest_volume,
             tets: mesh.tets.clone(),
             boundary,
+            cuts: None,
             particle_radius,
             rest_centre: (lo + hi) * 0.5,
             size: (hi - lo).norm(),
@@ -567,7 +570,7 @@ impl Body {
         }
     }
 
-    fn update_inverse_masses(&mut self) {
+    pub(crate) fn update_inverse_masses(&mut self) {
         for i in 0..self.x.len() {
             self.inv_mass[i] = if self.fixed[i] {
                 0.0
@@ -579,7 +582,7 @@ impl Body {
 
     /// An estimate (N/m) of each particle's diagonal stiffness at rest: the elastic terms of
     /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms.
-    fn diagonal_stiffness(&self) -> Vec<Real> {
+    pub(crate) fn diagonal_stiffness(&self) -> Vec<Real> {
         let pwave = self.model.p_wave_modulus();
         let mut k = vec![0.0; self.x.len()];
         for (i, vi) in self.particle_volume.iter().enumerate() {

@@ -28,6 +28,7 @@ pub(crate) mod body;
 pub(crate) mod collision;
 pub(crate) mod consistency;
 pub(crate) mod constraints;
+pub mod cut;
 pub(crate) mod divergence;
 pub(crate) mod elastic;
 pub(crate) mod error;
@@ -54,6 +55,7 @@ pub use collision::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,
 };
+pub use cut::{Blade, CutReport};
 pub use error::Error;
 pub use grasp::GraspOptions;
 pub use math::{tet_volume, Mat3, Quat, Real, Vec3};

@@ -12,6 +12,7 @@
 //! | per tool in the world (removed tools left out), in id order: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
 //! | then its grasp: slip force (N), attachment count, and per attachment body, particle, anchor in the tool frame (m), compliance (m/N) | f64, u32, (u32, u32, f64 × 4)… |
 //! | then its needle: punctured body (`u32::MAX`: none, or not a needle), entry point (m), hold count, and per hold particle, anchor in the tool frame (m) | u32, f64 × 3, u32, (u32, f64 × 3)… |
+//! | per body: cut pairs (count, load-time pair indices, increasing), removed tetrahedra (count, load-time indices, increasing) | u32, u32…, u32, u32… |
 //! | FNV-1a 64 checksum of everything before it | u64 |
 //!
 //! The scene itself (meshes, materials, fixed particles, settings) is not part of the state: a
@@ -125,6 +126,14 @@ impl World {
             + self.tool_extras(|g, n| {
                 g.attachments.len() * ATTACHMENT_BYTES + n.map_or(0, |n| n.holds.len() * HOLD_BYTES)
             })
+            + self
+                .bodies
+                .iter()
+                .map(|b| {
+                    let (pairs, tets) = crate::cut::cut_sets(b);
+                    8 + 4 * (pairs.len() + tets.len())
+                })
+                .sum::<usize>()
             + 8
     }
 
@@ -189,6 +198,13 @@ impl World {
                 }
             }
         }
+        for b in &self.bodies {
+            let (pairs, tets) = crate::cut::cut_sets(b);
+            for list in [pairs, tets] {
+                w.u32(list.len() as u32);
+                list.iter().for_each(|&k| w.u32(k));
+            }
+        }
         let sum = fnv1a(&out[start..]);
         out.extend_from_slice(&sum.to_le_bytes());
     }
@@ -219,7 +235,8 @@ impl World {
         if fnv1a(&bytes[..body_len]) != sum {
             return bad("checksum mismatch (corrupted state)");
         }
-        let extras = self.read_tool_extras(bytes)?;
+        let (extras, cuts_at) = self.read_tool_extras(bytes)?;
+        let cuts = self.read_cuts(bytes, cuts_at)?;
         // Check particle counts and finiteness before changing anything.
         let mut check = Reader { bytes, at: HEADER };
         for b in &self.bodies {
@@ -264,6 +281,9 @@ impl World {
             scan.at += extra.bytes;
         }
         // Everything checked: apply.
+        for (b, (pairs, tets)) in self.bodies.iter_mut().zip(&cuts) {
+            crate::cut::restore(b, pairs, tets);
+        }
         r.at = HEADER - 8;
         self.time = r.f64();
         for b in &mut self.bodies {
@@ -303,7 +323,7 @@ impl World {
     /// one per tool in the world, after checking the state's length against the counts it
     /// declares and every attachment and hold against this world (body, particle, finite
     /// anchor, compliance ≥ 0, needle state only for needles).
-    fn read_tool_extras(&self, bytes: &[u8]) -> Result<Vec<ToolExtras>, Error> {
+    fn read_tool_extras(&self, bytes: &[u8]) -> Result<(Vec<ToolExtras>, usize), Error> {
         let bad = |m: String| Err(Error::BadState(m));
         let mut at = HEADER;
         for b in &self.bodies {
@@ -398,12 +418,49 @@ impl World {
             });
             at = r.at;
         }
+        Ok((out, at))
+    }
+
+    /// The cut sets of every body (cut pairs, removed tetrahedra; load-time indices) from the
+    /// section starting at `at`, after checking them against this world's bodies (in range,
+    /// strictly increasing) and the state's length.
+    fn read_cuts(&self, bytes: &[u8], mut at: usize) -> Result<Vec<crate::cut::CutSets>, Error> {
+        let mut out = Vec::with_capacity(self.bodies.len());
+        for (k, b) in self.bodies.iter().enumerate() {
+            let (pair_count, tet_count) = crate::cut::load_time_counts(b);
+            let mut lists = [Vec::new(), Vec::new()];
+            for (list, limit) in lists.iter_mut().zip([pair_count, tet_count]) {
+                if at + 4 + 8 > bytes.len() {
+                    return Err(Error::BadState("state too short for its cut sets".into()));
+                }
+                let mut r = Reader { bytes, at };
+                let count = r.u32() as usize;
+                let end = count.checked_mul(4).map(|n| n + r.at);
+                if !end.is_some_and(|end| end + 8 <= bytes.len()) {
+                    return Err(Error::BadState(format!(
+                        "body {k}: {count} cut entries beyond the state's end"
+                    )));
+                }
+                for _ in 0..count {
+                    let v = r.u32();
+                    if v as usize >= limit || list.last().is_some_and(|&last| last >= v) {
+                        return Err(Error::BadState(format!(
+                            "body {k}: cut entry {v} out of range or out of order"
+                        )));
+                    }
+                    list.push(v);
+                }
+                at = r.at;
+            }
+            let [pairs, tets] = lists;
+            out.push((pairs, tets));
+        }
         if at + 8 != bytes.len() {
-            return bad(format!(
+            return Err(Error::BadState(format!(
                 "state is {} bytes, this world's layout gives {}",
                 bytes.len(),
                 at + 8
-            ));
+            )));
         }
         Ok(out)
     }

@@ -21,6 +21,7 @@ use crate::constraints::contact::{
 };
 use crate::constraints::friction::friction_correction;
 use crate::constraints::volume::project_volume_tet;
+use crate::cut::{Blade, CutReport};
 use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
@@ -51,6 +52,8 @@ pub struct StepReport {
     pub substeps: u32,
     /// True when stability asked for more than `Settings::max_substeps` substeps.
     pub substeps_clamped: bool,
+    /// What the blades cut at the end of this step (all bodies together).
+    pub cut: CutReport,
 }
 
 /// Friction between two bodies.
@@ -71,6 +74,8 @@ pub struct World {
     pub(crate) grasps: Vec<Grasp>,
     /// The needle of each tool, by tool id (`None`: not a needle).
     pub(crate) needles: Vec<Option<Needle>>,
+    /// Whether each tool, by id, is a blade.
+    pub(crate) blades: Vec<bool>,
     render_surfaces: Vec<RenderSurface>,
     pair_friction: Vec<PairFriction>,
     grid: HashGrid,
@@ -90,6 +95,7 @@ impl World {
             tools: Vec::new(),
             grasps: Vec::new(),
             needles: Vec::new(),
+            blades: Vec::new(),
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             grid: HashGrid::default(),
@@ -287,6 +293,7 @@ impl World {
             .push(Some(Tool::new(shape, pose, options, spacing)?));
         self.grasps.push(Grasp::default());
         self.needles.push(None);
+        self.blades.push(false);
         Ok(ToolId(id))
     }
     /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
@@ -297,7 +304,33 @@ impl World {
         self.tools[id.0 as usize] = None;
         self.grasps[id.0 as usize] = Grasp::default();
         self.needles[id.0 as usize] = None;
+        self.blades[id.0 as usize] = false;
         Ok(())
+    }
+    /// Cut body `id` with `blade` now (see [`crate::cut`]): the neighbour pairs and tetrahedra
+    /// crossed by the blade's swept edge are removed. Nothing changes on error.
+    pub fn cut(&mut self, id: BodyId, blade: &Blade) -> Result<CutReport, Error> {
+        let ends = blade.from.iter().chain(&blade.to);
+        if ends.clone().any(|p| !is_finite_vec(p)) {
+            return Err(Error::NonFinite("blade edge".into()));
+        }
+        self.body(id)?;
+        Ok(crate::cut::cut(&mut self.bodies[id.0 as usize], blade))
+    }
+    /// Make tool `id` (a capsule or a cylinder) a blade: its edge is the segment of its local y
+    /// axis between ±half_height; at the end of every step it cuts every body along the surface
+    /// its edge swept during the step, and it does not push the tissue (a blade slices). Nothing
+    /// changes on error.
+    pub fn make_blade(&mut self, id: ToolId) -> Result<(), Error> {
+        match self.tool(id)?.description {
+            ToolShape::Capsule { .. } | ToolShape::Cylinder { .. } => {
+                self.blades[id.0 as usize] = true;
+                Ok(())
+            }
+            _ => Err(Error::InvalidArgument(
+                "a blade is a capsule or a cylinder tool (edge along local y)".into(),
+            )),
+        }
     }
     /// Make tool `id` (a capsule or a cylinder: the shaft along local y, the tip at local +y) a
     /// needle: it punctures the tissue when the tissue pushes back on its tip with the puncture
@@ -571,6 +604,29 @@ impl World {
         for grasp in &mut self.grasps {
             grasp.end_step(h, n);
         }
+        let mut cut = CutReport::default();
+        for (t, _) in self.tools.iter().zip(&self.blades).filter(|(_, &b)| b) {
+            let Some(t) = t else { continue };
+            let half = match t.description {
+                ToolShape::Capsule { half_height, .. }
+                | ToolShape::Cylinder { half_height, .. } => half_height,
+                _ => continue,
+            };
+            let edge = |p: &Pose| {
+                let iso = p.isometry();
+                [-half, half].map(|y| iso.transform_point(&Point::new(0.0, y, 0.0)).coords)
+            };
+            let blade = Blade {
+                from: edge(&t.pose),
+                to: edge(&t.target),
+            };
+            for body in &mut self.bodies {
+                let r = crate::cut::cut(body, &blade);
+                cut.pairs += r.pairs;
+                cut.tets += r.tets;
+                cut.isolated += r.isolated;
+            }
+        }
         let dt = self.settings.dt;
         for t in self.tools.iter_mut().flatten() {
             let scale = -1.0 / (h * h * n as Real);
@@ -592,6 +648,7 @@ impl World {
         Ok(StepReport {
             substeps: n,
             substeps_clamped: clamped,
+            cut,
         })
     }
 
@@ -637,8 +694,13 @@ impl World {
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;
-            for (tool, needle) in self.tools.iter_mut().zip(&self.needles) {
+            for ((tool, needle), &blade) in
+                self.tools.iter_mut().zip(&self.needles).zip(&self.blades)
+            {
                 let Some(tool) = tool else { continue };
+                if blade {
+                    continue;
+                }
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 for (b, body) in self.bodies.iter_mut().enumerate() {

@@ -47,11 +47,14 @@ pub mod grasp;
 
 pub mod needle;
 
+pub mod cut;
+
 pub mod state;
 
 pub mod render;
 
 pub use body::{ts_body_options, ts_material};
+pub use cut::ts_cut_report;
 pub use grasp::ts_grasp_options;
 pub use needle::{ts_needle_options, ts_needle_state};
 pub use status::ts_status;

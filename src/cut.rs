@@ -1,0 +1,359 @@
+//! Cutting: a blade swept through a body removes the neighbour pairs and tetrahedra it crosses.
+//!
+//! The blade is a segment (its edge); over a step it sweeps the quadrilateral between its edge at
+//! the start and at the end of the step, split into two triangles. At the end of the step, in
+//! the deformed configuration:
+//!
+//! - every neighbour pair `(i, j)` whose segment `x_i x_j` crosses the swept surface is cut (the
+//!   visibility criterion of meshfree cutting: a particle no longer sees a neighbour through the
+//!   cut). Particles that lost a neighbour get their MLS gradients recomputed from the
+//!   neighbours they still see (first-order consistent; the load-time variationally consistent
+//!   correction is not re-imposed there); a particle left with fewer than four neighbours, or an
+//!   ill-conditioned moment matrix, loses its elasticity (it stays in the volume constraints);
+//! - every tetrahedron with an edge crossing the swept surface is removed from the volume
+//!   constraints and from the volume, and the boundary surface is rebuilt from the remaining
+//!   tetrahedra (so the cut faces become boundary);
+//! - with mass scaling, the particles whose stiffness grew get their inertial mass scaled by the
+//!   same factor (their local frequency does not rise: the step stays stable without a new
+//!   global estimate); without it, the stability limit is estimated anew.
+//!
+//! No buffer grows: cut pairs keep their slots with zero coefficients, and the tetrahedra are
+//! removed in place. The set of cut pairs and tetrahedra is part of the saved state; restoring
+//! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
+
+use crate::body::Body;
+use crate::math::{Mat3, Real, Vec3};
+use crate::mesh::TetMesh;
+
+/// A blade's edge at the start and at the end of its motion over one step (m, world frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Blade {
+    /// The edge's two ends at the start of the motion.
+    pub from: [Vec3; 2],
+    /// The edge's two ends at the end of the motion.
+    pub to: [Vec3; 2],
+}
+
+/// What a cut removed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CutReport {
+    /// Neighbour pairs cut by this call.
+    pub pairs: usize,
+    /// Tetrahedra removed by this call.
+    pub tets: usize,
+    /// Particles left without elasticity by this call (too few neighbours).
+    pub isolated: usize,
+}
+
+/// The cut pairs and removed tetrahedra of a body (load-time indices, increasing).
+pub(crate) type CutSets = (Vec<u32>, Vec<u32>);
+
+/// Load-time data of a body, kept from its first cut on, and what has been cut.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct CutState {
+    gradient: Vec<Vec3>,
+    hourglass_weight: Vec<Real>,
+    tets: Vec<[u32; 4]>,
+    tet_rest_volume: Vec<Real>,
+    /// Load-time inertial masses (kg) and diagonal stiffnesses (N/m) of the particles.
+    inertial_mass: Vec<Real>,
+    stiffness: Vec<Real>,
+    /// Per pair (load-time order): cut.
+    pub(crate) pair_cut: Vec<bool>,
+    /// Per load-time tetrahedron: removed.
+    pub(crate) tet_cut: Vec<bool>,
+}
+
+impl CutState {
+    fn new(body: &Body) -> CutState {
+        CutState {
+            gradient: body.nbr.gradient.clone(),
+            hourglass_weight: body.nbr.hourglass_weight.clone(),
+            tets: body.tets.clone(),
+            tet_rest_volume: body.tet_rest_volume.clone(),
+            inertial_mass: body.inertial_mass.clone(),
+            stiffness: body.diagonal_stiffness(),
+            pair_cut: vec![false; body.nbr.pair_count()],
+            tet_cut: vec![false; body.tets.len()],
+        }
+    }
+}
+
+/// Smallest number of remaining neighbours for a particle to keep its elasticity.
+const MIN_NEIGHBOURS: usize = 4;
+/// Largest condition number of a recomputed moment matrix.
+const MAX_CONDITION: Real = 1e8;
+
+/// Whether segment `p q` crosses triangle `a b c` (Möller–Trumbore, the segment's interior
+/// against the closed triangle).
+fn segment_crosses(p: &Vec3, q: &Vec3, [a, b, c]: &[Vec3; 3]) -> bool {
+    let d = q - p;
+    let (e1, e2) = (b - a, c - a);
+    let h = d.cross(&e2);
+    let det = e1.dot(&h);
+    if det.abs() < 1e-300 {
+        return false;
+    }
+    let inv = 1.0 / det;
+    let s = p - a;
+    let u = s.dot(&h) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let qv = s.cross(&e1);
+    let v = d.dot(&qv) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let t = e2.dot(&qv) * inv;
+    (0.0..=1.0).contains(&t)
+}
+
+/// The swept surface of `blade` as two triangles, and its bounding box.
+fn swept(blade: &Blade) -> ([[Vec3; 3]; 2], Vec3, Vec3) {
+    let ([a0, b0], [a1, b1]) = (blade.from, blade.to);
+    let tris = [[a0, b0, b1], [a0, b1, a1]];
+    let (mut lo, mut hi) = (a0, a0);
+    for p in [b0, a1, b1] {
+        lo = lo.inf(&p);
+        hi = hi.sup(&p);
+    }
+    (tris, lo, hi)
+}
+
+fn crosses(p: &Vec3, q: &Vec3, tris: &[[Vec3; 3]; 2], lo: &Vec3, hi: &Vec3) -> bool {
+    let (plo, phi) = (p.inf(q), p.sup(q));
+    if (0..3).any(|k| phi[k] < lo[k] || plo[k] > hi[k]) {
+        return false;
+    }
+    tris.iter().any(|t| segment_crosses(p, q, t))
+}
+
+/// Cut `body` with `blade` (see the module documentation). A blade that crosses nothing
+/// changes nothing.
+pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
+    let (tris, lo, hi) = swept(blade);
+    let x = &body.x;
+    let nbr = &body.nbr;
+    let already = |e: usize| body.cuts.as_ref().is_some_and(|c| c.pair_cut[e]);
+    let mut new_pairs = Vec::new();
+    for i in 0..x.len() {
+        for e in nbr.range(i) {
+            let j = nbr.index[e] as usize;
+            if !already(e) && crosses(&x[i], &x[j], &tris, &lo, &hi) {
+                new_pairs.push(e);
+            }
+        }
+    }
+    let mut new_tets = Vec::new();
+    let original_tets = body.cuts.as_ref().map_or(&body.tets, |c| &c.tets);
+    for (t, tet) in original_tets.iter().enumerate() {
+        if body.cuts.as_ref().is_some_and(|c| c.tet_cut[t]) {
+            continue;
+        }
+        let p = tet.map(|k| x[k as usize]);
+        let edges = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+        if edges
+            .iter()
+            .any(|&(a, b)| crosses(&p[a], &p[b], &tris, &lo, &hi))
+        {
+            new_tets.push(t);
+        }
+    }
+    if new_pairs.is_empty() && new_tets.is_empty() {
+        return CutReport::default();
+    }
+    let mut state = body
+        .cuts
+        .take()
+        .unwrap_or_else(|| Box::new(CutState::new(body)));
+    new_pairs.iter().for_each(|&e| state.pair_cut[e] = true);
+    new_tets.iter().for_each(|&t| state.tet_cut[t] = true);
+    let isolated = apply(body, state, Some(&new_pairs));
+    CutReport {
+        pairs: new_pairs.len(),
+        tets: new_tets.len(),
+        isolated,
+    }
+}
+
+/// Rebuild `body`'s topology for the cut sets of `state`: gradients of the particles with cut
+/// pairs (all particles with a cut pair when `changed` is `None`, else the centres of the pairs
+/// in `changed`), the tetrahedra, the rest volume, the boundary and the stability data. Returns
+/// the number of particles left without elasticity among those recomputed.
+fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> usize {
+    let n = body.x.len();
+    let mut rows = vec![false; n];
+    match changed {
+        Some(pairs) => {
+            for &e in pairs {
+                rows[centre_of(body, e)] = true;
+            }
+        }
+        None => {
+            body.nbr.gradient.copy_from_slice(&state.gradient);
+            body.nbr
+                .hourglass_weight
+                .copy_from_slice(&state.hourglass_weight);
+            for (e, &cut) in state.pair_cut.iter().enumerate() {
+                if cut {
+                    rows[centre_of(body, e)] = true;
+                }
+            }
+        }
+    }
+    let mut isolated = 0;
+    for (i, &row) in rows.iter().enumerate() {
+        if row && !recompute_row(body, &state.pair_cut, i) {
+            isolated += 1;
+        }
+    }
+    body.tets.clear();
+    body.tet_rest_volume.clear();
+    for (t, tet) in state.tets.iter().enumerate() {
+        if !state.tet_cut[t] {
+            body.tets.push(*tet);
+            body.tet_rest_volume.push(state.tet_rest_volume[t]);
+        }
+    }
+    // Within the load-time capacity: no allocation.
+    body.tet_lambda.resize(body.tets.len(), 0.0);
+    body.rest_volume = body.tet_rest_volume.iter().sum();
+    let mesh = TetMesh {
+        nodes: body.rest.clone(),
+        tets: body.tets.clone(),
+    };
+    body.boundary = mesh.boundary_triangles();
+    restabilise(body, &state);
+    body.cuts = Some(state);
+    isolated
+}
+
+/// Keep the step stable after a change of topology. With mass scaling (load-time inertial
+/// masses above the physical ones), a particle whose diagonal stiffness rose above its load-time
+/// value gets its load-time inertial mass scaled by the same factor, so its local frequency
+/// stays where mass scaling put it; a function of the current topology only, so restoring a
+/// state reproduces it. Without mass scaling, the stability limit is estimated anew.
+fn restabilise(body: &mut Body, state: &CutState) {
+    let scaled = state
+        .inertial_mass
+        .iter()
+        .zip(&body.mass)
+        .any(|(mi, m)| mi > m);
+    if scaled {
+        let now = body.diagonal_stiffness();
+        let base = state.inertial_mass.iter().zip(&state.stiffness);
+        for ((mi, (m0, k0)), k) in body.inertial_mass.iter_mut().zip(base).zip(&now) {
+            let ratio = if *k0 > 0.0 { (k / k0).max(1.0) } else { 1.0 };
+            *mi = m0 * ratio;
+        }
+        body.update_inverse_masses();
+    } else {
+        body.omega_max = crate::stability::max_angular_frequency(
+            body.rest_positions(),
+            body.inertial_masses(),
+            |x| body.elastic_forces_at(x),
+        );
+    }
+}
+
+/// The particle whose neighbourhood holds pair `e`.
+fn centre_of(body: &Body, e: usize) -> usize {
+    body.nbr.offsets.partition_point(|&o| o as usize <= e) - 1
+}
+
+/// Recompute particle `i`'s MLS gradients (poly6 kernel, its support radius) and hourglass
+/// weights from its uncut pairs; cut pairs get zeros. False (and all zeros) when fewer than
+/// [`MIN_NEIGHBOURS`] remain or the moment matrix is ill-conditioned.
+fn recompute_row(body: &mut Body, pair_cut: &[bool], i: usize) -> bool {
+    let nbr = &mut body.nbr;
+    let range = nbr.range(i);
+    let h2 = nbr.support_radius[i] * nbr.support_radius[i];
+    let weight = |u: &Vec3| {
+        let s = 1.0 - u.norm_squared() / h2;
+        if s > 0.0 {
+            s * s * s
+        } else {
+            0.0
+        }
+    };
+    let mut a = Mat3::zeros();
+    let (mut wsum, mut alive) = (0.0, 0);
+    for e in range.clone() {
+        if !pair_cut[e] {
+            let u = nbr.rest_offset[e];
+            let w = weight(&u);
+            a += u * u.transpose() * w;
+            wsum += w;
+            alive += 1;
+        }
+    }
+    let eig = a.symmetric_eigenvalues();
+    let inverse = (alive >= MIN_NEIGHBOURS && eig.min() > eig.max() / MAX_CONDITION && wsum > 0.0)
+        .then(|| a.try_inverse())
+        .flatten();
+    for e in range {
+        let u = nbr.rest_offset[e];
+        match inverse {
+            Some(inv) if !pair_cut[e] => {
+                let w = weight(&u);
+                nbr.gradient[e] = inv * u * w;
+                nbr.hourglass_weight[e] = w / wsum / u.norm_squared();
+            }
+            _ => {
+                nbr.gradient[e] = Vec3::zeros();
+                nbr.hourglass_weight[e] = 0.0;
+            }
+        }
+    }
+    inverse.is_some()
+}
+
+/// The cut pairs and removed tetrahedra of `body` (load-time indices, increasing), for the
+/// saved state.
+pub(crate) fn cut_sets(body: &Body) -> CutSets {
+    let Some(c) = &body.cuts else {
+        return (Vec::new(), Vec::new());
+    };
+    let list = |v: &[bool]| {
+        v.iter()
+            .enumerate()
+            .filter(|(_, &b)| b)
+            .map(|(k, _)| k as u32)
+            .collect()
+    };
+    (list(&c.pair_cut), list(&c.tet_cut))
+}
+
+/// Give `body` exactly the cut sets `pairs` and `tets` (load-time indices, checked by the
+/// caller to be in range): uncut when both are empty.
+pub(crate) fn restore(body: &mut Body, pairs: &[u32], tets: &[u32]) {
+    if cut_sets(body) == (pairs.to_vec(), tets.to_vec()) {
+        return;
+    }
+    let mut state = body
+        .cuts
+        .take()
+        .unwrap_or_else(|| Box::new(CutState::new(body)));
+    state.pair_cut.iter_mut().for_each(|c| *c = false);
+    state.tet_cut.iter_mut().for_each(|c| *c = false);
+    pairs
+        .iter()
+        .for_each(|&e| state.pair_cut[e as usize] = true);
+    tets.iter().for_each(|&t| state.tet_cut[t as usize] = true);
+    apply(body, state, None);
+}
+
+/// Number of load-time pairs and tetrahedra of `body` (the ranges of the saved cut sets).
+pub(crate) fn load_time_counts(body: &Body) -> (usize, usize) {
+    let tets = body.cuts.as_ref().map_or(body.tets.len(), |c| c.tets.len());
+    (body.nbr.pair_count(), tets)
+}
+
+impl Body {
+    /// Neighbour pairs cut and tetrahedra removed so far (0, 0 for a body never cut).
+    pub fn cut_counts(&self) -> (usize, usize) {
+        let (pairs, tets) = cut_sets(self);
+        (pairs.len(), tets.len())
+    }
+}
