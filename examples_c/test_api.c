@@ -252,18 +252,31 @@ static void test_coverage(double h) {
     ts_world_free(world);
 }
 
+/* A world with default settings holding the lattice of build_lattice (default material) as
+ * body *out_body; its bottom face fixed when `fix_bottom`. */
+static ts_world *lattice_world(int fix_bottom, uint32_t *out_body) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, out_body));
+    if (fix_bottom) {
+        double lo[3] = {OX - 1, -1, -1}, hi[3] = {OX + 1, 1e-9, 1};
+        CHECK_OK(ts_body_fix_box(world, *out_body, lo, hi, NULL));
+    }
+    return world;
+}
+
 /* Grasping: a sphere touching the top of a free lattice grasps it (ts_tool_grasp), holds it
  * hanging for 2 s: the pull on the tool equals the lattice's weight (within 5%); release lets
  * it fall away. Bad options and stale ids give their statuses. */
 static void test_grasp(double h) {
-    ts_settings settings;
-    ts_material material;
-    ts_world *world = NULL;
     uint32_t body = 99, ball = 99, count = 99;
-    CHECK_OK(ts_settings_default(&settings));
+    ts_world *world = lattice_world(0, &body);
+    ts_material material;
     CHECK_OK(ts_material_default(&material));
-    CHECK_OK(ts_world_new(&settings, &world));
-    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
     double radius = 0;
     CHECK_OK(ts_body_particle_radius(world, body, &radius));
     ts_pose top = {{OX + CELLS * h / 2, CELLS * h + 0.01 + 0.5 * radius, CELLS * h / 2},
@@ -313,16 +326,8 @@ static void test_grasp(double h) {
  * column of particles punctures it when the tissue pushes back with the puncture force, then
  * carries friction x inserted length; options and shapes are checked. */
 static void test_needle(double h) {
-    ts_settings settings;
-    ts_material material;
-    ts_world *world = NULL;
     uint32_t body = 99, needle = 99, ball = 99;
-    CHECK_OK(ts_settings_default(&settings));
-    CHECK_OK(ts_material_default(&material));
-    CHECK_OK(ts_world_new(&settings, &world));
-    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
-    double lo[3] = {OX - 1, -1, -1}, hi[3] = {OX + 1, 1e-9, 1};
-    CHECK_OK(ts_body_fix_box(world, body, lo, hi, NULL));
+    ts_world *world = lattice_world(1, &body);
     const double half = 0.05, r = 0.001, x = OX + h, z = h; /* over an interior column */
     double tip = CELLS * h + 0.015;
     /* Pointing down: a half turn about x (w = 0, x = 1). */
@@ -375,16 +380,8 @@ static void test_needle(double h) {
 /* Cutting: a horizontal blade swept through the middle of the lattice (bottom face fixed)
  * cuts it in two; the top half then falls under gravity. A capsule becomes a blade tool. */
 static void test_cut(double h) {
-    ts_settings settings;
-    ts_material material;
-    ts_world *world = NULL;
     uint32_t body = 99, blade = 99, ball = 99;
-    CHECK_OK(ts_settings_default(&settings));
-    CHECK_OK(ts_material_default(&material));
-    CHECK_OK(ts_world_new(&settings, &world));
-    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
-    double lo[3] = {OX - 1, -1, -1}, hi[3] = {OX + 1, 1e-9, 1};
-    CHECK_OK(ts_body_fix_box(world, body, lo, hi, NULL));
+    ts_world *world = lattice_world(1, &body);
     double y = 1.5 * h; /* between the second and third layers of nodes */
     double from[6] = {OX - 0.05, y, -0.05, OX - 0.05, y, CELLS * h + 0.05};
     double to[6] = {OX + CELLS * h + 0.05, y, -0.05, OX + CELLS * h + 0.05, y, CELLS * h + 0.05};
