@@ -211,6 +211,21 @@ static void hostile_numbers(void) {
             CHECK(st != TS_STATUS_PANIC);
             if (st == TS_STATUS_OK) CHECK_OK(ts_tool_release(w, tool));
         }
+        /* a blade edge with one hostile coordinate: refused (or, finite, cuts nothing this
+         * far from the body), the world unchanged. */
+        for (int c = 0; c < 12; c++) {
+            double from[6] = {5, 5, 5, 5, 5, 6}, to[6] = {6, 5, 5, 6, 5, 6};
+            if (c < 6) from[c] = v; else to[c - 6] = v;
+            ts_cut_report report;
+            st = ts_world_cut(w, body, from, to, &report);
+            CHECK(st != TS_STATUS_PANIC);
+            if (st == TS_STATUS_OK) CHECK(report.pairs == 0 && report.tets == 0);
+        }
+        /* needle options with a hostile puncture force: refused (never a panic). */
+        ts_needle_options no;
+        CHECK_OK(ts_needle_options_default(&no));
+        no.puncture_force = v;
+        CHECK_REFUSED(ts_tool_make_needle(w, tool, &no));
         CHECK(unchanged(w, before, len));
     }
     /* stale ids. */
