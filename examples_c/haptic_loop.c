@@ -10,8 +10,9 @@
  * (step,time_s,probe_x,probe_y,probe_z,fx_N,fy_N,fz_N,contacts,latency_us) to FORCE.csv, or
  * every 100th row to stdout when no file is given.
  *
- * TS_STEPS=N sets the number of steps (default 2000 = 2 s); TS_NO_SLEEP=1 runs flat out
- * without waiting for the 1 ms deadlines (used under valgrind).
+ * TS_STEPS=N sets the number of steps (default 2000 = 2 s); TS_THREADS=N the solver threads
+ * (default 2: the calling thread and one worker; results are bit-identical for any count);
+ * TS_NO_SLEEP=1 runs flat out without waiting for the 1 ms deadlines (used under valgrind).
  *
  * Build: cc -Iinclude examples_c/haptic_loop.c -Ltarget/release -ltissuesim -lm -o haptic_loop
  */
@@ -89,6 +90,7 @@ int main(int argc, char **argv) {
 
     ts_settings settings;
     TRY(ts_settings_default(&settings)); /* dt = 1 ms */
+    settings.threads = getenv("TS_THREADS") ? (uint32_t)atol(getenv("TS_THREADS")) : 2;
     TRY(ts_world_new(&settings, &world));
     ts_material material;
     TRY(ts_material_default(&material)); /* E = 5 kPa, nu = 0.45, rho = 1060 */
@@ -141,8 +143,9 @@ int main(int argc, char **argv) {
     else
         fputs(header, stdout);
 
-    printf("# %zu particles, probe r = %.0f mm pressing %.0f mm, %ld steps at 1 kHz%s\n", n,
-           1e3 * radius, 1e3 * depth, steps, no_sleep ? " (no sleeping)" : "");
+    printf("# %zu particles, probe r = %.0f mm pressing %.0f mm, %ld steps at 1 kHz on %u "
+           "thread(s)%s\n",
+           n, 1e3 * radius, 1e3 * depth, steps, settings.threads, no_sleep ? " (no sleeping)" : "");
 
     long missed = 0;
     double max_force = 0;
