@@ -41,6 +41,7 @@ pub(crate) mod neighbours;
 pub(crate) mod parallel;
 pub mod render;
 pub(crate) mod settings;
+pub(crate) mod solver;
 pub(crate) mod stability;
 pub mod state;
 pub mod statics;

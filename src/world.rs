@@ -1,28 +1,10 @@
-//! The scene: bodies, tools and settings; [`World::step`] runs Algorithm 1 of the paper.
-//!
-//! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
-//! limit of the stiffest body, at least `Settings::min_substeps`). Each substep:
-//! 1. forces: gravity, point-based elasticity with hourglass control and pair damping;
-//! 2. symplectic prediction `v ← v/(1 + α h) + h f/m`, `p = x + h v` (fixed particles stay);
-//! 3. `Settings::iterations` Gauss–Seidel passes over the XPBD tetrahedron volume constraints,
-//!    organ–organ contacts (with friction) and tool contacts (with friction), in that order;
-//! 4. `v = (p - x)/h`, `x = p`.
-//!
-//! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation). After the step every position and velocity is
-//! checked: a NaN or Inf rolls the world back to its state before the step and the step returns
-//! [`Error::Diverged`] (counted by [`World::diverged_steps`]).
+//! The scene: bodies, tools, render surfaces and settings, and the API that builds and queries
+//! it. [`World::step`], Algorithm 1 of the paper, lives in the `solver` module, one pass a file.
 
-use crate::body::{Body, BodyOptions, ROTATION_ITERATIONS};
+use crate::body::{Body, BodyOptions};
 use crate::collision::hash_grid::HashGrid;
-use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape, Wrench};
-use crate::constraints::contact::{
-    project_particle_particle, project_point_sphere, project_point_surface, ContactProjection,
-};
-use crate::constraints::friction::friction_correction;
-use crate::constraints::volume::project_volume_tet;
+use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
-use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
 use crate::math::{is_finite_vec, Real, Vec3};
@@ -30,8 +12,7 @@ use crate::mesh::TetMesh;
 use crate::needle::{Needle, NeedleOptions, NeedleState};
 use crate::parallel::Pool;
 use crate::render::{RenderMesh, RenderSurface};
-use crate::settings::{ContactMode, Settings};
-use parry3d_f64::math::Point;
+use crate::settings::Settings;
 
 /// Identifies a body inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -58,10 +39,10 @@ pub struct StepReport {
 
 /// Friction between two bodies.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct PairFriction {
-    bodies: (u32, u32),
-    mu_s: Real,
-    mu_k: Real,
+pub(crate) struct PairFriction {
+    pub(crate) bodies: (u32, u32),
+    pub(crate) mu_s: Real,
+    pub(crate) mu_k: Real,
 }
 
 /// A simulated scene.
@@ -76,12 +57,12 @@ pub struct World {
     pub(crate) needles: Vec<Option<Needle>>,
     /// Whether each tool, by id, is a blade.
     pub(crate) blades: Vec<bool>,
-    render_surfaces: Vec<RenderSurface>,
-    pair_friction: Vec<PairFriction>,
-    grid: HashGrid,
-    pool: Pool,
+    pub(crate) render_surfaces: Vec<RenderSurface>,
+    pub(crate) pair_friction: Vec<PairFriction>,
+    pub(crate) grid: HashGrid,
+    pub(crate) pool: Pool,
     pub(crate) time: Real,
-    diverged_steps: u64,
+    pub(crate) diverged_steps: u64,
 }
 
 impl World {
@@ -562,346 +543,5 @@ impl World {
             max_speed: speed,
             converged: speed < SETTLE_SPEED,
         })
-    }
-
-    /// Advance the world by `settings.dt`. When a body becomes non-finite or leaves the
-    /// physical bounds of [`Settings::divergence`] the world is rolled back to the start of the
-    /// step and [`Error::Diverged`] says which body and why.
-    pub fn step(&mut self) -> Result<StepReport, Error> {
-        let (n, clamped) = self.substeps_needed();
-        for b in &mut self.bodies {
-            b.saved_x.copy_from_slice(&b.x);
-            b.saved_v.copy_from_slice(&b.v);
-            b.saved_rotation.copy_from_slice(&b.rotation);
-        }
-        let h = self.settings.dt / n as Real;
-        for t in self.tools.iter_mut().flatten() {
-            t.acc_impulse = Vec3::zeros();
-            t.acc_moment = Vec3::zeros();
-            t.acc_penetration = 0.0;
-        }
-        for k in 1..=n {
-            self.substep(h, k, n);
-        }
-        let limits = self.settings.divergence;
-        let failure =
-            self.bodies.iter().enumerate().find_map(|(b, body)| {
-                crate::divergence::diverged(body, &limits).map(|why| (b, why))
-            });
-        if let Some((b, why)) = failure {
-            for body in &mut self.bodies {
-                body.x.copy_from_slice(&body.saved_x);
-                body.v.copy_from_slice(&body.saved_v);
-                body.rotation.copy_from_slice(&body.saved_rotation);
-            }
-            self.diverged_steps += 1;
-            return Err(Error::Diverged(format!(
-                "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
-                 restore a state, or reduce dt or the stiffness)",
-                self.time
-            )));
-        }
-        for grasp in &mut self.grasps {
-            grasp.end_step(h, n);
-        }
-        let mut cut = CutReport::default();
-        for (t, _) in self.tools.iter().zip(&self.blades).filter(|(_, &b)| b) {
-            let Some(t) = t else { continue };
-            let half = match t.description {
-                ToolShape::Capsule { half_height, .. }
-                | ToolShape::Cylinder { half_height, .. } => half_height,
-                _ => continue,
-            };
-            let edge = |p: &Pose| {
-                let iso = p.isometry();
-                [-half, half].map(|y| iso.transform_point(&Point::new(0.0, y, 0.0)).coords)
-            };
-            let blade = Blade {
-                from: edge(&t.pose),
-                to: edge(&t.target),
-            };
-            for body in &mut self.bodies {
-                let r = crate::cut::cut(body, &blade);
-                cut.pairs += r.pairs;
-                cut.tets += r.tets;
-                cut.isolated += r.isolated;
-            }
-        }
-        let dt = self.settings.dt;
-        for t in self.tools.iter_mut().flatten() {
-            let scale = -1.0 / (h * h * n as Real);
-            t.wrench = Wrench {
-                force: t.acc_impulse * scale,
-                torque: t.acc_moment * scale,
-                contact_count: t.acc_contacts,
-                max_penetration: t.acc_penetration,
-            };
-            t.linear_velocity = (t.target.position - t.pose.position) / dt;
-            t.pose = t.target;
-        }
-        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
-            if let (Some(tool), Some(needle)) = (tool, needle) {
-                needle.end_step(tool, &self.bodies);
-            }
-        }
-        self.time += dt;
-        Ok(StepReport {
-            substeps: n,
-            substeps_clamped: clamped,
-            cut,
-        })
-    }
-
-    /// Substep `k` of `n` (1-based) of length `h` (s).
-    fn substep(&mut self, h: Real, k: u32, n: u32) {
-        let s = &self.settings;
-        let gravity = s.gravity;
-        let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
-        for body in &mut self.bodies {
-            predict(body, gravity, h, alpha_damp, &self.pool);
-        }
-        let organ_contact = self.bodies.len() > 1 || s.self_contact;
-        if organ_contact {
-            let cell = 2.0
-                * self
-                    .bodies
-                    .iter()
-                    .map(|b| b.particle_radius)
-                    .fold(0.0, Real::max);
-            self.grid
-                .build(self.bodies.iter().map(|b| b.p.as_slice()), cell);
-        }
-        for t in self.tools.iter_mut().flatten() {
-            t.acc_contacts = 0;
-        }
-        self.grasps.iter_mut().for_each(Grasp::begin_substep);
-        let s_cur = k as Real / n as Real;
-        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
-            if let (Some(tool), Some(needle)) = (tool, needle) {
-                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                needle.begin_substep(&self.bodies, &cur);
-            }
-        }
-        let s_prev = (k - 1) as Real / n as Real;
-        for it in 0..self.settings.iterations {
-            if self.settings.volume_constraints {
-                for body in &mut self.bodies {
-                    project_volumes(body, h);
-                }
-            }
-            if organ_contact {
-                self.project_organ_contacts();
-            }
-            let mode = self.settings.contact_mode;
-            let max_correction = self.settings.max_depenetration_speed * h;
-            for ((tool, needle), &blade) in
-                self.tools.iter_mut().zip(&self.needles).zip(&self.blades)
-            {
-                let Some(tool) = tool else { continue };
-                if blade {
-                    continue;
-                }
-                let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
-                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                for (b, body) in self.bodies.iter_mut().enumerate() {
-                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) {
-                        continue;
-                    }
-                    let motion = (&prev, &cur);
-                    project_tool_contacts(tool, body, motion, mode, max_correction, it == 0);
-                }
-            }
-            for (tool, grasp) in self.tools.iter_mut().zip(&mut self.grasps) {
-                if let Some(tool) = tool {
-                    if !grasp.attachments.is_empty() {
-                        let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                        grasp.project(tool, &mut self.bodies, &cur, h);
-                    }
-                }
-            }
-            for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
-                if let (Some(tool), Some(needle)) = (tool, needle) {
-                    let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                    needle.project(tool, &mut self.bodies, &cur, h);
-                }
-            }
-        }
-        for body in &mut self.bodies {
-            let inv_h = 1.0 / h;
-            for i in 0..body.x.len() {
-                body.v[i] = (body.p[i] - body.x[i]) * inv_h;
-                body.x[i] = body.p[i];
-            }
-        }
-    }
-
-    fn project_organ_contacts(&mut self) {
-        let self_contact = self.settings.self_contact;
-        let nb = self.bodies.len();
-        for a in 0..nb {
-            for i in 0..self.bodies[a].particle_count() {
-                let pi = self.bodies[a].p[i];
-                let grid = &self.grid;
-                let bodies = &mut self.bodies;
-                let friction = &self.pair_friction;
-                grid.for_each_near(&pi, |[b, j]| {
-                    let (b, j) = (b as usize, j as usize);
-                    if (b, j) <= (a, i) || (a == b && !self_contact) {
-                        return;
-                    }
-                    let ra = bodies[a].particle_radius;
-                    let rb = bodies[b].particle_radius;
-                    if a == b {
-                        // Particles close at rest belong to the same piece of tissue.
-                        let rest_d = (bodies[a].rest[i] - bodies[a].rest[j]).norm();
-                        if rest_d < 2.0 * (ra + rb) {
-                            return;
-                        }
-                    }
-                    let (wa, wb) = (bodies[a].inv_mass[i], bodies[b].inv_mass[j]);
-                    let (mut pa, mut pb) = (bodies[a].p[i], bodies[b].p[j]);
-                    let Some(c) = project_particle_particle(&mut pa, &mut pb, wa, wb, ra + rb)
-                    else {
-                        return;
-                    };
-                    let key = (a.min(b) as u32, a.max(b) as u32);
-                    if let Some(f) = friction.iter().find(|f| f.bodies == key) {
-                        let rel = (pa - bodies[a].x[i]) - (pb - bodies[b].x[j]);
-                        let dfr = friction_correction(&rel, &c.normal, c.depth, f.mu_s, f.mu_k);
-                        let wsum = wa + wb;
-                        pa += dfr * (wa / wsum);
-                        pb -= dfr * (wb / wsum);
-                    }
-                    bodies[a].p[i] = pa;
-                    bodies[b].p[j] = pb;
-                });
-            }
-        }
-    }
-}
-
-/// Forces, then the symplectic prediction of one body for a substep `h` (s).
-fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real, pool: &Pool) {
-    for i in 0..body.x.len() {
-        body.force[i] = gravity * body.mass[i];
-    }
-    let input = ForceInputs {
-        nbr: &body.nbr,
-        volume: &body.particle_volume,
-        x: &body.x,
-        v: &body.v,
-    };
-    accumulate_forces(
-        &body.model,
-        &input,
-        &mut body.rotation,
-        ROTATION_ITERATIONS,
-        &mut body.pair_force,
-        &mut body.own_force,
-        &mut body.force,
-        pool,
-    );
-    for i in 0..body.x.len() {
-        let w = body.inv_mass[i];
-        if body.fixed[i] {
-            body.v[i] = Vec3::zeros();
-            body.p[i] = body.x[i];
-        } else {
-            body.v[i] = body.v[i] * damping_factor + body.force[i] * (h * w);
-            body.p[i] = body.x[i] + body.v[i] * h;
-        }
-    }
-    body.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
-}
-
-/// One Gauss–Seidel pass over a body's tetrahedron volume constraints for a substep `h` (s).
-/// Each constraint's XPBD compliance is the body's compliance per unit volume (1/Pa) times the
-/// tetrahedron's rest volume (m³), divided by h².
-fn project_volumes(body: &mut Body, h: Real) {
-    if !body.volume_compliance.is_finite() {
-        return;
-    }
-    let compliance_per_h2 = body.volume_compliance / (h * h);
-    for t in 0..body.tets.len() {
-        let v0 = body.tet_rest_volume[t];
-        project_volume_tet(
-            &mut body.p,
-            &body.inv_mass,
-            body.tets[t],
-            v0,
-            compliance_per_h2 * v0,
-            &mut body.tet_lambda[t],
-        );
-    }
-}
-
-/// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this
-/// substep) and the particles of `body`, with friction, each normal correction at most
-/// `max_correction` (m), and accumulate the tool's impulse and moment.
-fn project_tool_contacts(
-    tool: &mut Tool,
-    body: &mut Body,
-    (prev, cur): (&Pose, &Pose),
-    mode: ContactMode,
-    max_correction: Real,
-    count: bool,
-) {
-    let iso = cur.isometry();
-    // Maps a point attached to the tool at `cur` to where it was at `prev`.
-    let back = prev.isometry() * iso.inverse();
-    let centre = cur.position;
-    let r = body.particle_radius;
-    let reach = tool.bounding_radius + r;
-    let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
-    for i in 0..body.x.len() {
-        if body.inv_mass[i] == 0.0 {
-            continue;
-        }
-        let before = body.p[i];
-        if (before - centre).norm_squared() > reach * reach {
-            continue;
-        }
-        let mut p = before;
-        // The last contact point on the tool surface, where the impulse acts on the tool.
-        let mut touched: Option<Vec3> = None;
-        let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
-            let tool_motion = contact - back.transform_point(&Point::from(contact)).coords;
-            let rel = (*p - body.x[i]) - tool_motion;
-            *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
-            tool.acc_penetration = tool.acc_penetration.max(c.depth);
-            touched = Some(contact);
-        };
-        match mode {
-            ContactMode::ExactShape => {
-                let proj = tool.shape.project_point(&iso, &Point::from(p), false);
-                let fallback = (p - centre).try_normalize(1e-12).unwrap_or_else(Vec3::y);
-                let surface = proj.point.coords;
-                let inside = proj.is_inside;
-                if let Some(c) =
-                    project_point_surface(&mut p, &surface, inside, r, &fallback, max_correction)
-                {
-                    apply(&mut p, c, surface, tool);
-                }
-            }
-            ContactMode::SampledPoints => {
-                let rs = tool.sample_radius;
-                for s in 0..tool.samples.len() {
-                    let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
-                    if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, max_correction) {
-                        let contact = sw + c.normal * rs;
-                        apply(&mut p, c, contact, tool);
-                    }
-                }
-            }
-        }
-        if let Some(contact) = touched {
-            let impulse = (p - before) * body.inertial_mass[i];
-            tool.acc_impulse += impulse;
-            tool.acc_moment += (contact - centre).cross(&impulse);
-            if count {
-                tool.acc_contacts += 1;
-            }
-            body.p[i] = p;
-        }
     }
 }

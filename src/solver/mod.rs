@@ -1,0 +1,218 @@
+//! The step: [`World::step`] runs Algorithm 1 of the paper as a sequence of passes, one file
+//! each.
+//!
+//! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
+//! limit of the stiffest body, at least `Settings::min_substeps`). Data flow of one step:
+//!
+//! 1. save `x`, `v`, rotations (the rollback copy); clear the tools' wrench accumulators;
+//! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
+//!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
+//!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
+//!    [`tool_contact`] (each tool against each body, friction, wrench), then the grasps
+//!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
+//! 3. the divergence check (`crate::divergence`): a failure restores the rollback copy;
+//! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
+//!    poses, needle puncture or withdrawal, time.
+//!
+//! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
+//! substeps (linear position, slerp orientation). The bodies own their state (`x`, `v`,
+//! rotations) and their scratch (`p`, forces, multipliers); the world owns the hash grid and
+//! the thread pool.
+
+mod organ_contact;
+mod predict;
+mod tool_contact;
+mod volume;
+
+use crate::collision::tool::{Pose, ToolShape, Wrench};
+use crate::cut::{Blade, CutReport};
+use crate::error::Error;
+use crate::grasp::Grasp;
+use crate::math::{Real, Vec3};
+use crate::world::{StepReport, World};
+use parry3d_f64::math::Point;
+
+impl World {
+    /// Advance the world by `settings.dt`. When a body becomes non-finite or leaves the
+    /// physical bounds of [`Settings::divergence`](crate::Settings::divergence) the world is rolled back to the start of the
+    /// step and [`Error::Diverged`] says which body and why.
+    pub fn step(&mut self) -> Result<StepReport, Error> {
+        let (n, clamped) = self.substeps_needed();
+        for b in &mut self.bodies {
+            b.saved_x.copy_from_slice(&b.x);
+            b.saved_v.copy_from_slice(&b.v);
+            b.saved_rotation.copy_from_slice(&b.rotation);
+        }
+        let h = self.settings.dt / n as Real;
+        for t in self.tools.iter_mut().flatten() {
+            t.acc_impulse = Vec3::zeros();
+            t.acc_moment = Vec3::zeros();
+            t.acc_penetration = 0.0;
+        }
+        for k in 1..=n {
+            self.substep(h, k, n);
+        }
+        let limits = self.settings.divergence;
+        let failure =
+            self.bodies.iter().enumerate().find_map(|(b, body)| {
+                crate::divergence::diverged(body, &limits).map(|why| (b, why))
+            });
+        if let Some((b, why)) = failure {
+            for body in &mut self.bodies {
+                body.x.copy_from_slice(&body.saved_x);
+                body.v.copy_from_slice(&body.saved_v);
+                body.rotation.copy_from_slice(&body.saved_rotation);
+            }
+            self.diverged_steps += 1;
+            return Err(Error::Diverged(format!(
+                "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
+                 restore a state, or reduce dt or the stiffness)",
+                self.time
+            )));
+        }
+        for grasp in &mut self.grasps {
+            grasp.end_step(h, n);
+        }
+        let mut cut = CutReport::default();
+        for (t, _) in self.tools.iter().zip(&self.blades).filter(|(_, &b)| b) {
+            let Some(t) = t else { continue };
+            let half = match t.description {
+                ToolShape::Capsule { half_height, .. }
+                | ToolShape::Cylinder { half_height, .. } => half_height,
+                _ => continue,
+            };
+            let edge = |p: &Pose| {
+                let iso = p.isometry();
+                [-half, half].map(|y| iso.transform_point(&Point::new(0.0, y, 0.0)).coords)
+            };
+            let blade = Blade {
+                from: edge(&t.pose),
+                to: edge(&t.target),
+            };
+            for body in &mut self.bodies {
+                let r = crate::cut::cut(body, &blade);
+                cut.pairs += r.pairs;
+                cut.tets += r.tets;
+                cut.isolated += r.isolated;
+            }
+        }
+        let dt = self.settings.dt;
+        for t in self.tools.iter_mut().flatten() {
+            let scale = -1.0 / (h * h * n as Real);
+            t.wrench = Wrench {
+                force: t.acc_impulse * scale,
+                torque: t.acc_moment * scale,
+                contact_count: t.acc_contacts,
+                max_penetration: t.acc_penetration,
+            };
+            t.linear_velocity = (t.target.position - t.pose.position) / dt;
+            t.pose = t.target;
+        }
+        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
+            if let (Some(tool), Some(needle)) = (tool, needle) {
+                needle.end_step(tool, &self.bodies);
+            }
+        }
+        self.time += dt;
+        Ok(StepReport {
+            substeps: n,
+            substeps_clamped: clamped,
+            cut,
+        })
+    }
+
+    /// Substep `k` of `n` (1-based) of length `h` (s).
+    fn substep(&mut self, h: Real, k: u32, n: u32) {
+        let s = &self.settings;
+        let gravity = s.gravity;
+        let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
+        for body in &mut self.bodies {
+            predict::predict(body, gravity, h, alpha_damp, &self.pool);
+        }
+        let organ_contact = self.bodies.len() > 1 || s.self_contact;
+        if organ_contact {
+            let cell = 2.0
+                * self
+                    .bodies
+                    .iter()
+                    .map(|b| b.particle_radius)
+                    .fold(0.0, Real::max);
+            self.grid
+                .build(self.bodies.iter().map(|b| b.p.as_slice()), cell);
+        }
+        for t in self.tools.iter_mut().flatten() {
+            t.acc_contacts = 0;
+        }
+        self.grasps.iter_mut().for_each(Grasp::begin_substep);
+        let s_cur = k as Real / n as Real;
+        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
+            if let (Some(tool), Some(needle)) = (tool, needle) {
+                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                needle.begin_substep(&self.bodies, &cur);
+            }
+        }
+        let s_prev = (k - 1) as Real / n as Real;
+        for it in 0..self.settings.iterations {
+            if self.settings.volume_constraints {
+                for body in &mut self.bodies {
+                    volume::project_volumes(body, h);
+                }
+            }
+            if organ_contact {
+                organ_contact::project_organ_contacts(
+                    &self.grid,
+                    &mut self.bodies,
+                    &self.pair_friction,
+                    self.settings.self_contact,
+                );
+            }
+            let mode = self.settings.contact_mode;
+            let max_correction = self.settings.max_depenetration_speed * h;
+            for ((tool, needle), &blade) in
+                self.tools.iter_mut().zip(&self.needles).zip(&self.blades)
+            {
+                let Some(tool) = tool else { continue };
+                if blade {
+                    continue;
+                }
+                let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
+                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                for (b, body) in self.bodies.iter_mut().enumerate() {
+                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) {
+                        continue;
+                    }
+                    let motion = (&prev, &cur);
+                    tool_contact::project_tool_contacts(
+                        tool,
+                        body,
+                        motion,
+                        mode,
+                        max_correction,
+                        it == 0,
+                    );
+                }
+            }
+            for (tool, grasp) in self.tools.iter_mut().zip(&mut self.grasps) {
+                if let Some(tool) = tool {
+                    if !grasp.attachments.is_empty() {
+                        let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                        grasp.project(tool, &mut self.bodies, &cur, h);
+                    }
+                }
+            }
+            for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
+                if let (Some(tool), Some(needle)) = (tool, needle) {
+                    let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                    needle.project(tool, &mut self.bodies, &cur, h);
+                }
+            }
+        }
+        for body in &mut self.bodies {
+            let inv_h = 1.0 / h;
+            for i in 0..body.x.len() {
+                body.v[i] = (body.p[i] - body.x[i]) * inv_h;
+                body.x[i] = body.p[i];
+            }
+        }
+    }
+}
