@@ -76,7 +76,7 @@ fi
 # Binaries of an earlier run must not stand in for ones that fail to compile now.
 rm -f "$OUT"/header_check_* "$OUT"/hello "$OUT"/hello_cpp "$OUT"/haptic_loop "$OUT"/sofa_liver \
     "$OUT"/test_api "$OUT"/test_api_static "$OUT"/hostile "$OUT"/hostile_asan \
-    "$OUT"/render_surface "$OUT"/test_render_surface
+    "$OUT"/render_surface "$OUT"/test_render_surface "$OUT"/surgery
 
 echo "== compiling the header as C and C++ (header_check.c)"
 for std in c99 c11; do
@@ -97,7 +97,7 @@ for std in c++11 c++17; do
 done
 
 echo "== compiling"
-PROGRAMS=(hello haptic_loop sofa_liver test_api render_surface test_render_surface)
+PROGRAMS=(hello haptic_loop sofa_liver test_api render_surface test_render_surface surgery)
 for p in "${PROGRAMS[@]}"; do
     if "$CC" "${CFLAGS[@]}" "examples_c/$p.c" -L"$LIB_DIR" -ltissuesim -lm -o "$OUT/$p"; then
         pass "compile $p.c (shared)"
@@ -176,6 +176,7 @@ if [ -x "$OUT/render_surface" ]; then
     if [ "$frames" -eq 5 ]; then pass "render_surface wrote 5 OBJ frames"; else fail "render_surface wrote $frames OBJ frames, 5 expected"; fi
 fi
 [ -x "$OUT/test_render_surface" ] && run test_render_surface -- "$OUT/test_render_surface" "$OUT/render_scratch"
+[ -x "$OUT/surgery" ] && run surgery -- "$OUT/surgery"
 
 if [ "${SKIP_VALGRIND:-0}" = 1 ]; then
     echo "SKIP valgrind (SKIP_VALGRIND=1)"
@@ -215,5 +216,6 @@ fi
     "${VG[@]}" "$OUT/render_surface" "$MESHES" "$OUT/render_frames"
 [ -x "$OUT/test_render_surface" ] && run valgrind-test_render_surface -- \
     "${VG[@]}" "$OUT/test_render_surface" "$OUT/render_scratch"
+[ -x "$OUT/surgery" ] && run valgrind-surgery TS_STEPS=3 -- "${VG[@]}" "$OUT/surgery"
 
 finish
