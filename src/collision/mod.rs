@@ -4,3 +4,4 @@
 pub mod hash_grid;
 pub mod sampling;
 pub mod tool;
+pub(crate) mod winding;
