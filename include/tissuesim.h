@@ -346,11 +346,13 @@ typedef struct ts_wrench {
      */
     double torque[3];
     /**
-     * Largest penetration of a particle into the tool before projection, last step (m).
+     * Largest contact violation before projection, last step (m): how far the surface was
+     * inside the tool's contact skin.
      */
     double max_penetration;
     /**
-     * Number of particles in contact with the tool at the last substep.
+     * Number of contacts at the last substep: boundary triangles touching the tool in the
+     * exact-shape contact mode, particles in the sampled-points mode.
      */
     uint32_t contact_count;
 } ts_wrench;
@@ -1035,7 +1037,8 @@ enum ts_status ts_tool_wrench(const struct ts_world *world,
                               struct ts_wrench *out_wrench);
 
 /**
- * Number of particles in contact with the tool at the last substep into *out_count.
+ * Number of contacts of the tool at the last substep (boundary triangles in the exact-shape
+ * contact mode, particles in the sampled-points mode) into *out_count.
  *
  * # Safety
  *

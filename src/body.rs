@@ -126,7 +126,9 @@ pub struct BodyOptions {
     pub support_radius: Option<Real>,
     /// Target number of neighbours when the support radius is chosen automatically.
     pub target_neighbours: u32,
-    /// Contact radius of the particles (m); `None` derives it from the particle spacing.
+    /// Contact radius of the particles (m) for organ–organ contact and the sampled-points tool
+    /// contact, and the thickness of the contact skin over the boundary surface that tools touch
+    /// in the exact-shape mode; `None` takes half the mean tetrahedron edge.
     pub particle_radius: Option<Real>,
     /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
     /// divergence theorem (variationally consistent integration, Chen, Hillman & Rüter 2013): a
@@ -438,6 +440,12 @@ impl Body {
     pub fn neighbourhoods(&self) -> &Neighbourhoods {
         &self.nbr
     }
+    /// Whether `point` (m, world frame) is inside the body's deformed boundary surface (its
+    /// winding number about the point is above one half). Cost: one pass over the boundary
+    /// triangles.
+    pub fn contains(&self, point: &Vec3) -> bool {
+        crate::collision::winding::inside_surface(point, &self.x, &self.boundary)
+    }
     /// Current volume (m³): the sum of the signed tetrahedron volumes.
     pub fn volume(&self) -> Real {
         volume_of(&self.x, &self.tets)
@@ -465,6 +473,11 @@ impl Body {
     /// Contact radius of the particles (m).
     pub fn particle_radius(&self) -> Real {
         self.particle_radius
+    }
+    /// Thickness of the contact skin over the boundary surface (m): tools in the exact-shape
+    /// contact mode touch the surface this far out of it (the particle radius).
+    pub fn contact_skin(&self) -> Real {
+        crate::solver::SURFACE_SKIN * self.particle_radius
     }
     /// Total mass (kg).
     pub fn mass(&self) -> Real {

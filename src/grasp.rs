@@ -9,9 +9,9 @@
 //! (times its mass) goes into the tool's wrench like a contact's, so the tool's force is the
 //! tissue's pull in N. When the attachments together pull on the tool with more than
 //! [`GraspOptions::max_force`] the tissue slips out of the jaws: every attachment is released.
-//! [`World::release`](crate::World::release) lets go; free contact with the tool then acts as
-//! before (anchors lie outside the tool, where contact put the particles, so holding and contact
-//! do not fight).
+//! While a tool holds particles of a body, contact between that tool and that body is off (the
+//! jaws enclose the tissue, and contact would fight the attachments);
+//! [`World::release`](crate::World::release) lets go and contact acts again.
 
 use crate::body::Body;
 use crate::collision::tool::{Pose, Tool};
@@ -23,8 +23,9 @@ use parry3d_f64::math::Point;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GraspOptions {
     /// Particles whose centre is within this distance (m) of the tool's surface (or inside it)
-    /// are grasped. `None`: 1.5 × the body's particle radius — the particles in contact (which
-    /// sit one particle radius from the surface) and none of the layer behind them.
+    /// are grasped. `None`: 1.5 × the body's particle radius (three quarters of the mean edge by
+    /// default) — the corners of the surface triangles the tool touches and none of the layer
+    /// of particles behind them.
     pub reach: Option<Real>,
     /// Compliance of each attachment (m/N; 0 = rigid). `None`: `1 / (E r)`, the compliance of a
     /// cube of the body's tissue one particle radius `r` across (E its Young's modulus), so the
@@ -110,6 +111,12 @@ impl Default for Grasp {
 }
 
 impl Grasp {
+    /// Whether any particle of body `b` is held: contact between the tool and that body is then
+    /// off (the jaws enclose the tissue; contact would fight the attachments).
+    pub(crate) fn holds(&self, b: usize) -> bool {
+        self.attachments.iter().any(|a| a.body as usize == b)
+    }
+
     /// The free particles of `bodies` within the options' reach of `tool` (at its current pose),
     /// anchored where they are. Empty when nothing is within reach.
     pub(crate) fn new(

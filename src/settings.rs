@@ -6,11 +6,15 @@ use crate::math::{Real, Vec3};
 /// How tool–tissue contact is detected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactMode {
-    /// Exact distance from each particle to the tool's shape (parry point projection, with
-    /// inside detection). The default: no gaps between samples, a smooth force.
+    /// The tool's exact shape against the body's deformed boundary triangles (GJK), the
+    /// correction spread over each triangle's particles by barycentric weights, one-sided and
+    /// swept so that a tool thinner than the particle spacing neither slips between particles
+    /// nor tunnels. Contact starts a skin of one particle radius out from the
+    /// surface. The default.
     ExactShape,
     /// The paper's mode: the tool surface sampled into points, each a sphere of radius equal to
-    /// the sample spacing; particles are pushed out of those spheres.
+    /// the sample spacing; particles (spheres of the particle radius) are pushed out of those
+    /// spheres. Tools thinner than the particle spacing can slip between particles.
     SampledPoints,
 }
 
@@ -77,11 +81,13 @@ pub struct Settings {
     pub iterations: u32,
     /// How tool–tissue contact is detected.
     pub contact_mode: ContactMode,
-    /// Largest speed (m/s) at which a tool contact pushes a particle out of the tool: a
-    /// substep moves a particle by at most `max_depenetration_speed · h` along the contact
-    /// normal, so a tool that jumps into the tissue (a haptic glitch) is left by the particles
-    /// gently over the following steps instead of flinging them out (PhysX's
-    /// `maxDepenetrationVelocity`). Normal probing is far slower than the default.
+    /// Largest speed (m/s) at which a tool contact removes a penetration that was already
+    /// there at the start of a substep: a substep moves a particle (or a surface triangle's
+    /// contact point) along the contact normal by at most its own motion in that substep plus
+    /// `max_depenetration_speed · h`, so a tool that jumps into the tissue (a haptic glitch) is
+    /// left by the particles gently over the following steps instead of flinging them out
+    /// (PhysX's `maxDepenetrationVelocity`), while tissue that moves into a tool is stopped
+    /// whole. Normal probing is far slower than the default.
     pub max_depenetration_speed: Real,
     /// Enable contact between particles of the same body (off by default).
     pub self_contact: bool,

@@ -60,6 +60,8 @@ pub struct World {
     pub(crate) render_surfaces: Vec<RenderSurface>,
     pub(crate) pair_friction: Vec<PairFriction>,
     pub(crate) grid: HashGrid,
+    /// Scratch memory of the tool–surface contact pass.
+    pub(crate) surface_scratch: crate::solver::SurfaceScratch,
     pub(crate) pool: Pool,
     pub(crate) time: Real,
     pub(crate) diverged_steps: u64,
@@ -80,6 +82,7 @@ impl World {
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             grid: HashGrid::default(),
+            surface_scratch: Default::default(),
             time: 0.0,
             diverged_steps: 0,
         })

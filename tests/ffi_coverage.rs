@@ -463,16 +463,20 @@ fn convex_hull_and_triangle_tools_are_validated() {
     assert_eq!((t, w.tool_count()), (2, 3));
 }
 
-/// The lateral force (N, along x) on a 1 cm probe pressed into the hanging cube and dragged
-/// 3 mm sideways, with tool friction (mu_s, mu_k).
+/// The lateral force (N, along x) on a flat 2 × 2 cm pad pressed into the bottom face of the
+/// hanging cube and dragged 3 mm sideways, with tool friction (mu_s, mu_k). Flat on a flat face,
+/// the pad meets no sloped surface, so without friction there is next to no drag.
 fn drag_force(friction: Option<(f64, f64)>) -> f64 {
     let w = hanging_cube();
     let mut t = u32::MAX;
+    let half = [0.01, 0.005, 0.01];
+    let below = [BELOW[0], BELOW[1] + 0.005, BELOW[2]];
+    let pressed = [PRESSED[0], PRESSED[1] + 0.005, PRESSED[2]];
     ok(unsafe {
-        ts_world_add_tool_sphere(
+        ts_world_add_tool_box(
             w.0,
-            0.01,
-            &pose(BELOW[0], BELOW[1], BELOW[2]),
+            half.as_ptr(),
+            &pose(below[0], below[1], below[2]),
             null(),
             &mut t,
         )
@@ -484,9 +488,9 @@ fn drag_force(friction: Option<(f64, f64)>) -> f64 {
         let o = unsafe { o.assume_init() };
         assert_eq!((o.friction_static, o.friction_kinetic), (s, k));
     }
-    w.drive(t, BELOW, PRESSED, 40, 10);
-    let side = [PRESSED[0] + 0.003, PRESSED[1], PRESSED[2]];
-    w.drive(t, PRESSED, side, 30, 0);
+    w.drive(t, below, pressed, 40, 10);
+    let side = [pressed[0] + 0.003, pressed[1], pressed[2]];
+    w.drive(t, pressed, side, 30, 0);
     w.wrench(t).force[0]
 }
 

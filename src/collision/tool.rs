@@ -270,9 +270,12 @@ pub struct Wrench {
     pub force: Vec3,
     /// Torque on the tool about its origin (N·m, world frame).
     pub torque: Vec3,
-    /// Number of particles in contact with the tool at the last substep.
+    /// Number of contacts at the last substep: boundary triangles touching the tool in the
+    /// exact-shape contact mode, particles in the sampled-points mode.
     pub contact_count: u32,
-    /// Largest penetration depth of a particle into the tool (m) before projection, last step.
+    /// Largest contact violation (m) before projection in the last step: how far a surface
+    /// triangle was inside the tool's skin (a particle inside its contact radius in the
+    /// sampled-points mode).
     pub max_penetration: Real,
 }
 

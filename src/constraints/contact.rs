@@ -14,45 +14,6 @@ pub struct ContactProjection {
     pub correction: Real,
 }
 
-/// Push a particle at `p` out of an obstacle: the particle must be at least `r` (m) from the
-/// obstacle surface, whose closest point is `surface` (m), the particle being inside the
-/// obstacle when `inside`. `fallback_normal` is used when `p` lies on the surface. The
-/// correction is at most `max_correction` (m). Returns the projection when the constraint was
-/// violated (and moves `p`).
-#[inline]
-pub fn project_point_surface(
-    p: &mut Vec3,
-    surface: &Vec3,
-    inside: bool,
-    r: Real,
-    fallback_normal: &Vec3,
-    max_correction: Real,
-) -> Option<ContactProjection> {
-    let offset = *p - surface;
-    let dist = offset.norm();
-    let (signed, normal) = if dist > 1e-12 {
-        let n = offset / dist;
-        if inside {
-            (-dist, -n)
-        } else {
-            (dist, n)
-        }
-    } else {
-        (0.0, *fallback_normal)
-    };
-    let c = signed - r;
-    if c >= 0.0 {
-        return None;
-    }
-    let correction = (-c).min(max_correction);
-    *p += normal * correction;
-    Some(ContactProjection {
-        normal,
-        depth: -c,
-        correction,
-    })
-}
-
 /// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m), by at
 /// most `max_correction` (m): the paper's point–point contact with a tool sample.
 #[inline]
@@ -120,21 +81,5 @@ mod tests {
         assert!(((a - b).norm() - 1.0).abs() < 1e-12);
         assert!((a * ma + b * mb - before).norm() < 1e-12);
         assert!((c.depth - 0.5).abs() < 1e-12);
-    }
-
-    #[test]
-    fn point_outside_beyond_radius_is_untouched_and_inside_is_pushed_out() {
-        let mut p = Vec3::new(0.0, 2.0, 0.0);
-        let surface = Vec3::new(0.0, 1.0, 0.0);
-        assert!(project_point_surface(&mut p, &surface, false, 0.5, &Vec3::y(), 1.0).is_none());
-        let mut q = Vec3::new(0.0, 0.8, 0.0);
-        let c = project_point_surface(&mut q, &surface, true, 0.5, &Vec3::y(), 1.0).unwrap();
-        assert!((q - Vec3::new(0.0, 1.5, 0.0)).norm() < 1e-12);
-        assert!((c.depth - 0.7).abs() < 1e-12);
-        // A limited correction moves by max_correction only and reports the full depth.
-        let mut s = Vec3::new(0.0, 0.8, 0.0);
-        let c = project_point_surface(&mut s, &surface, true, 0.5, &Vec3::y(), 0.1).unwrap();
-        assert!((s - Vec3::new(0.0, 0.9, 0.0)).norm() < 1e-12);
-        assert!((c.correction - 0.1).abs() < 1e-12 && (c.depth - 0.7).abs() < 1e-12);
     }
 }

@@ -89,9 +89,11 @@ pub struct ts_wrench {
     pub force: [f64; 3],
     /// Torque on the tool about its origin (N m, world frame), [x, y, z].
     pub torque: [f64; 3],
-    /// Largest penetration of a particle into the tool before projection, last step (m).
+    /// Largest contact violation before projection, last step (m): how far the surface was
+    /// inside the tool's contact skin.
     pub max_penetration: f64,
-    /// Number of particles in contact with the tool at the last substep.
+    /// Number of contacts at the last substep: boundary triangles touching the tool in the
+    /// exact-shape contact mode, particles in the sampled-points mode.
     pub contact_count: u32,
 }
 
@@ -350,7 +352,8 @@ pub unsafe extern "C" fn ts_tool_wrench(
     })
 }
 
-/// Number of particles in contact with the tool at the last substep into *out_count.
+/// Number of contacts of the tool at the last substep (boundary triangles in the exact-shape
+/// contact mode, particles in the sampled-points mode) into *out_count.
 ///
 /// # Safety
 ///

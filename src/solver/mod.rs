@@ -8,7 +8,10 @@
 //! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
-//!    [`tool_contact`] (each tool against each body, friction, wrench), then the grasps
+//!    tool contact (each tool against each body, friction, wrench:
+//!    [`surface_contact`] against the boundary triangles, or [`sampled_contact`], the paper's
+//!    tool samples against the particles; off between a needle and the body it punctured and
+//!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
 //! 3. the divergence check (`crate::divergence`): a failure restores the rollback copy;
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
@@ -21,14 +24,18 @@
 
 mod organ_contact;
 mod predict;
-mod tool_contact;
+mod sampled_contact;
+mod surface_contact;
 mod volume;
+
+pub(crate) use surface_contact::{SurfaceScratch, SURFACE_SKIN};
 
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
+use crate::settings::ContactMode;
 use crate::world::{StepReport, World};
 use parry3d_f64::math::Point;
 
@@ -168,8 +175,12 @@ impl World {
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;
-            for ((tool, needle), &blade) in
-                self.tools.iter_mut().zip(&self.needles).zip(&self.blades)
+            for (((tool, needle), &blade), grasp) in self
+                .tools
+                .iter_mut()
+                .zip(&self.needles)
+                .zip(&self.blades)
+                .zip(&self.grasps)
             {
                 let Some(tool) = tool else { continue };
                 if blade {
@@ -178,18 +189,27 @@ impl World {
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 for (b, body) in self.bodies.iter_mut().enumerate() {
-                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) {
+                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) || grasp.holds(b) {
                         continue;
                     }
                     let motion = (&prev, &cur);
-                    tool_contact::project_tool_contacts(
-                        tool,
-                        body,
-                        motion,
-                        mode,
-                        max_correction,
-                        it == 0,
-                    );
+                    match mode {
+                        ContactMode::ExactShape => surface_contact::project_tool_surface(
+                            &mut self.surface_scratch,
+                            tool,
+                            body,
+                            motion,
+                            (max_correction, h),
+                            it == 0,
+                        ),
+                        ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
+                            tool,
+                            body,
+                            motion,
+                            max_correction,
+                            it == 0,
+                        ),
+                    }
                 }
             }
             for (tool, grasp) in self.tools.iter_mut().zip(&mut self.grasps) {

@@ -1,21 +1,22 @@
-//! Tool–tissue contact of one tool with one body, with friction, accumulating the tool's wrench.
+//! Tool–tissue contact in the paper's sampled-points mode
+//! ([`ContactMode::SampledPoints`](crate::ContactMode::SampledPoints)): the tool's surface
+//! samples, each a sphere, against the body's particles, with friction, accumulating the tool's
+//! wrench.
 
 use crate::body::Body;
 use crate::collision::tool::{Pose, Tool};
-use crate::constraints::contact::{project_point_sphere, project_point_surface, ContactProjection};
+use crate::constraints::contact::{project_point_sphere, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
-use crate::settings::ContactMode;
 use parry3d_f64::math::Point;
 
-/// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this
-/// substep) and the particles of `body`, with friction, each normal correction at most
-/// `max_correction` (m), and accumulate the tool's impulse and moment.
-pub(crate) fn project_tool_contacts(
+/// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
+/// `motion.1` over this substep) and the particles of `body`, with friction, each normal
+/// correction at most `max_correction` (m), and accumulate the tool's impulse and moment.
+pub(crate) fn project_sampled_contacts(
     tool: &mut Tool,
     body: &mut Body,
     (prev, cur): (&Pose, &Pose),
-    mode: ContactMode,
     max_correction: Real,
     count: bool,
 ) {
@@ -44,27 +45,12 @@ pub(crate) fn project_tool_contacts(
             tool.acc_penetration = tool.acc_penetration.max(c.depth);
             touched = Some(contact);
         };
-        match mode {
-            ContactMode::ExactShape => {
-                let proj = tool.shape.project_point(&iso, &Point::from(p), false);
-                let fallback = (p - centre).try_normalize(1e-12).unwrap_or_else(Vec3::y);
-                let surface = proj.point.coords;
-                let inside = proj.is_inside;
-                if let Some(c) =
-                    project_point_surface(&mut p, &surface, inside, r, &fallback, max_correction)
-                {
-                    apply(&mut p, c, surface, tool);
-                }
-            }
-            ContactMode::SampledPoints => {
-                let rs = tool.sample_radius;
-                for s in 0..tool.samples.len() {
-                    let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
-                    if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, max_correction) {
-                        let contact = sw + c.normal * rs;
-                        apply(&mut p, c, contact, tool);
-                    }
-                }
+        let rs = tool.sample_radius;
+        for s in 0..tool.samples.len() {
+            let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
+            if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, max_correction) {
+                let contact = sw + c.normal * rs;
+                apply(&mut p, c, contact, tool);
             }
         }
         if let Some(contact) = touched {

@@ -1,0 +1,145 @@
+//! Contact against the organ's surface (the surgical-interaction issue, item 1): instruments
+//! thinner than the particle spacing press the deformed boundary triangles, not only the
+//! particles, so that they never pass into the tissue. Scene: the default organ hanging from its
+//! top 15%, settled at rest, a sphere pressed horizontally into it.
+
+mod common;
+
+use tissuesim::{
+    mesh, BodyId, BodyOptions, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+};
+
+/// How far the sphere is pressed past first contact (the contact skin over the surface, m).
+const PRESS: Real = 0.03;
+
+/// What a press measured.
+struct Press {
+    /// Steps on which the sphere's centre was inside the deformed surface.
+    inside_steps: usize,
+    /// Force on the sphere along the press direction reversed (N, > 0 pushes back), when its
+    /// front was 1, 2 and 3 cm past first contact.
+    push_back_at_cm: [Real; 3],
+    /// The smallest push-back (N) over the steps from the first that pushed back.
+    least_push_back: Real,
+}
+
+/// The default organ hanging from its top 15%, settled.
+fn hanging_organ() -> (World, BodyId) {
+    let organ = mesh::default_organ();
+    let mut world = World::new(Settings::default()).unwrap();
+    let body = world.add_body(&organ, &BodyOptions::default()).unwrap();
+    common::fix_top(&mut world, body, 0.15);
+    world.settle().unwrap();
+    (world, body)
+}
+
+/// Press a sphere of `radius` (m) at `speed` (m/s) along the horizontal unit `direction`, on the
+/// line through `through` (m), from 2 mm off the organ's contact skin until its front is
+/// [`PRESS`] past it.
+fn press(radius: Real, direction: Vec3, through: Vec3, speed: Real) -> Press {
+    let (mut world, body) = hanging_organ();
+    let near_line = |p: &&Vec3| {
+        let q = *p - through;
+        (q - direction * q.dot(&direction)).norm() < 0.01
+    };
+    let surface = world
+        .body(body)
+        .unwrap()
+        .positions()
+        .iter()
+        .filter(near_line)
+        .map(|p| (p - through).dot(&direction))
+        .fold(Real::INFINITY, Real::min);
+    assert!(surface.is_finite(), "no particle on the press line");
+    // Start 2 mm clear of the contact skin over the surface; depth counts from the skin.
+    let gap = 0.002;
+    let skin = world.body(body).unwrap().contact_skin();
+    let start = through + direction * (surface - skin - gap - radius);
+    let tool = world
+        .add_tool(
+            ToolShape::Sphere { radius },
+            Pose::at(start),
+            &ToolOptions::default(),
+        )
+        .unwrap();
+    let dt = world.settings().dt;
+    let steps = ((gap + PRESS) / speed / dt).round() as usize;
+    let mut touched = false;
+    let mut result = Press {
+        inside_steps: 0,
+        push_back_at_cm: [Real::NAN; 3],
+        least_push_back: Real::INFINITY,
+    };
+    for k in 1..=steps {
+        let travel = speed * k as Real * dt;
+        let centre = start + direction * travel;
+        world.set_tool_pose(tool, Pose::at(centre)).unwrap();
+        world.step().unwrap();
+        let push_back = -world.tool(tool).unwrap().wrench().force.dot(&direction);
+        result.inside_steps += world.body(body).unwrap().contains(&centre) as usize;
+        let depth = travel - gap;
+        touched |= push_back > 0.0;
+        if touched {
+            result.least_push_back = result.least_push_back.min(push_back);
+        }
+        for (cm, slot) in result.push_back_at_cm.iter_mut().enumerate() {
+            if slot.is_nan() && depth >= 0.01 * (cm + 1) as Real - 1e-9 {
+                *slot = push_back;
+            }
+        }
+    }
+    result
+}
+
+/// The facts of the issue for one press: the centre never inside, the force always pushing
+/// back, and growing with depth.
+fn assert_holds(what: &str, p: &Press) {
+    let [f1, f2, f3] = p.push_back_at_cm;
+    assert_eq!(
+        p.inside_steps, 0,
+        "{what}: centre inside the organ on {} steps",
+        p.inside_steps
+    );
+    assert!(
+        p.least_push_back > 0.0,
+        "{what}: the force stopped pushing back ({} N)",
+        p.least_push_back
+    );
+    assert!(
+        f2 > 1.2 * f1 && f3 > 1.2 * f2,
+        "{what}: force must grow with depth, got {f1:.3} / {f2:.3} / {f3:.3} N at 1 / 2 / 3 cm"
+    );
+}
+
+#[test]
+fn spheres_of_10_2_5_and_1_mm_pressed_3_cm_into_the_front_never_enter_the_organ() {
+    for radius in [0.010, 0.0025, 0.001] {
+        let p = press(radius, -Vec3::z(), Vec3::new(0.035, 0.0, 0.0), 0.05);
+        assert_holds(&format!("front, r = {} mm", radius * 1e3), &p);
+    }
+}
+
+#[test]
+fn a_1_mm_sphere_pressed_into_the_side_never_enters_the_organ() {
+    let (world, body) = hanging_organ();
+    let (lo, hi) = common::bounds(world.body(body).unwrap().positions());
+    let middle = (lo + hi) * 0.5;
+    let through = Vec3::new(0.0, middle.y, middle.z);
+    let p = press(0.001, Vec3::x(), through, 0.05);
+    assert_holds("side, r = 1 mm", &p);
+}
+
+#[test]
+fn a_1_mm_sphere_pushed_at_half_a_metre_per_second_does_not_tunnel() {
+    let p = press(0.001, -Vec3::z(), Vec3::new(0.035, 0.0, 0.0), 0.5);
+    assert_eq!(
+        p.inside_steps, 0,
+        "centre inside the organ on {} steps",
+        p.inside_steps
+    );
+    assert!(
+        p.least_push_back > 0.0,
+        "the force stopped pushing back ({} N)",
+        p.least_push_back
+    );
+}
