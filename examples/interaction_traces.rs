@@ -4,14 +4,20 @@
 //! - `needle_trace.csv`: a 1 mm capsule needle pushed 4 cm into the organ's front face at
 //!   2 cm/s, held 0.2 s, pulled back out at 2 cm/s (puncture force 0.3 N, friction 10 N/m);
 //! - `grasp_trace.csv`: a 5 mm sphere pressed 4 mm into the front face, grasping, pulled 3 cm
-//!   out at 2 cm/s, held 0.3 s, released, withdrawn.
+//!   out at 2 cm/s, held 0.3 s, released, withdrawn;
+//! - `press_trace_r{10,2.5,1}mm.csv`: spheres of radius 10, 2.5 and 1 mm pressed horizontally
+//!   into the front face at 5 cm/s until they are 3 cm past it; a summary line per radius on
+//!   stdout (steps with the centre inside the deformed surface, force at 1/2/3 cm, the force's
+//!   mean rise per step and its step-to-step jitter, the second difference, median and p99).
 //!
 //! ```text
 //! cargo run --release --example interaction_traces -- [OUT_DIR]    # default docs/data
 //! ```
 //! Columns: time (s), tool travel (m, along the motion), force along the motion (N, the
 //! tissue's force on the tool projected on the direction of travel into the organ), |F| (N),
-//! then needle: punctured (0/1), inserted length (m), held particles; grasp: grasped particles.
+//! then needle: punctured (0/1), inserted length (m), held particles; grasp: grasped particles;
+//! press: depth of the sphere's front past first contact (the contact skin over the undeformed
+//! face, m), centre inside (0/1).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -160,6 +166,70 @@ fn grasp_trace() -> Res<String> {
     Ok(csv)
 }
 
+/// Press a sphere of `radius` (m) into the front face at 5 cm/s until its front is 3 cm past
+/// first contact; returns the CSV trace and a one-line summary.
+fn press_trace(radius: Real) -> Res<(String, String)> {
+    let (mut world, body, face) = organ()?;
+    let dt = world.settings().dt;
+    let into = -Vec3::z();
+    // Start 2 mm clear of the contact skin; depth counts from the skin.
+    let gap = 0.002;
+    let skin = world.body(body)?.contact_skin();
+    let start = Vec3::new(0.035, 0.0, face + skin + gap + radius);
+    let tool = world.add_tool(
+        ToolShape::Sphere { radius },
+        Pose::at(start),
+        &ToolOptions::default(),
+    )?;
+    let (speed, press) = (0.05, 0.03);
+    let steps = ((gap + press) / speed / dt).round() as usize;
+    let mut csv = String::from("time_s,travel_m,depth_m,force_along_n,force_norm_n,inside\n");
+    let (mut inside_steps, mut in_contact) = (0, Vec::new());
+    let mut at_depth = [Real::NAN; 3];
+    for k in 1..=steps {
+        let t = k as Real * dt;
+        let travel = speed * t;
+        let depth = travel - gap;
+        let centre = start + into * travel;
+        let (along, norm) = step(&mut world, tool, Pose::at(centre), into)?;
+        let inside = world.body(body)?.contains(&centre);
+        inside_steps += inside as usize;
+        if depth > 0.0 {
+            in_contact.push(along);
+        }
+        for (cm, slot) in at_depth.iter_mut().enumerate() {
+            if slot.is_nan() && depth >= 0.01 * (cm + 1) as Real - 1e-9 {
+                *slot = along;
+            }
+        }
+        writeln!(
+            csv,
+            "{t:.4},{travel:.6},{depth:.6},{along:.6},{norm:.6},{}",
+            inside as u8
+        )?;
+    }
+    // Jitter: the second difference F[k+1] − 2 F[k] + F[k−1] (N), zero for a smooth ramp.
+    let mut jitter: Vec<Real> = in_contact
+        .windows(3)
+        .map(|f| (f[2] - 2.0 * f[1] + f[0]).abs())
+        .collect();
+    jitter.sort_by(Real::total_cmp);
+    let quantile = |q: Real| jitter[((jitter.len() - 1) as Real * q).round() as usize];
+    let ramp = (in_contact[in_contact.len() - 1] - in_contact[0]) / (in_contact.len() - 1) as Real;
+    let summary = format!(
+        "sphere r = {:.1} mm: centre inside on {inside_steps} of {steps} steps; force at 1/2/3 cm \
+         {:.3}/{:.3}/{:.3} N; mean rise {ramp:.2e} N/step, jitter |F[k+1] - 2F[k] + F[k-1]| \
+         median {:.2e} N, p99 {:.2e} N",
+        radius * 1e3,
+        at_depth[0],
+        at_depth[1],
+        at_depth[2],
+        quantile(0.5),
+        quantile(0.99)
+    );
+    Ok((csv, summary))
+}
+
 fn main() -> Res<()> {
     let out = std::env::args()
         .nth(1)
@@ -173,6 +243,16 @@ fn main() -> Res<()> {
         let path = out.join(name);
         std::fs::write(&path, csv)?;
         println!("wrote {}", path.display());
+    }
+    for (radius, name) in [
+        (0.010, "press_trace_r10mm.csv"),
+        (0.0025, "press_trace_r2.5mm.csv"),
+        (0.001, "press_trace_r1mm.csv"),
+    ] {
+        let (csv, summary) = press_trace(radius)?;
+        let path = out.join(name);
+        std::fs::write(&path, csv)?;
+        println!("wrote {}: {summary}", path.display());
     }
     Ok(())
 }

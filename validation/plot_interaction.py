@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""Force plots of the surgical interactions (grasping, needle insertion) on the default organ.
+"""Force plots of the surgical interactions (pressing, grasping, needle insertion) on the
+default organ.
 
-    cargo run --release --example interaction_traces            # writes docs/data/{grasp,needle}_trace.csv
+    cargo run --release --example interaction_traces    # writes docs/data/*_trace*.csv
     build/venv-validation/bin/python validation/plot_interaction.py
 
-Reads docs/data/grasp_trace.csv and docs/data/needle_trace.csv (a missing one is skipped with a
-note), writes docs/img/grasp_trace.png and docs/img/needle_trace.png and prints the figures
-quoted in docs/VALIDATION.md.
+Reads docs/data/grasp_trace.csv, needle_trace.csv and press_trace_r{10,2.5,1}mm.csv (a missing
+one is skipped with a note), writes docs/img/grasp_trace.png, needle_trace.png and
+surface_press_trace.png and prints the figures quoted in docs/VALIDATION.md.
 """
 import csv
 import os
@@ -77,8 +78,30 @@ def needle(d):
     fig.savefig(os.path.join(IMG, 'needle_trace.png'), dpi=120)
 
 
+def press(traces):
+    fig, ax = plt.subplots(figsize=(7, 3.6))
+    for label, d in traces:
+        ax.plot(d['depth_m'] * 1e3, d['force_along_n'], lw=1.0, label=label)
+        inside = int(d['inside'].sum())
+        print(f"press {label}: centre inside on {inside} of {len(d['inside'])} steps; "
+              f"{d['force_along_n'][-1]:.3f} N at {d['depth_m'][-1] * 1e3:.1f} mm")
+    ax.set_xlabel("sphere front past first contact (mm)")
+    ax.set_ylabel('force on the sphere, against the press (N)')
+    ax.set_title('Spheres pressed horizontally into the hanging organ at 5 cm/s')
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(IMG, 'surface_press_trace.png'), dpi=120)
+
+
 def main():
     os.makedirs(IMG, exist_ok=True)
+    traces = []
+    for r in ('10', '2.5', '1'):
+        d = read(f'press_trace_r{r}mm.csv')
+        if d is not None:
+            traces.append((f'r = {r} mm', d))
+    if traces:
+        press(traces)
     d = read('grasp_trace.csv')
     if d is not None:
         grasp(d)
