@@ -24,8 +24,8 @@ use crate::fmi2::{
 use std::path::{Path, PathBuf};
 use tissuesim::Quat;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, Error, GraspOptions, Material, Pose, Settings, ToolId, ToolOptions,
-    ToolShape, Vec3, World,
+    mesh, BodyId, BodyOptions, Error, GraspOptions, Material, NeedleOptions, Pose, Settings,
+    ToolId, ToolOptions, ToolShape, Vec3, World,
 };
 
 /// Default tool position (m): ~1.7 cm in front (+z) of the default organ's right lobe at
@@ -149,6 +149,9 @@ crate::fmi2_variables! {
         SETTLE = Variable::boolean("settle", Parameter, Fixed, false, "Start at rest: at fmi2ExitInitializationMode the organ is brought to its static equilibrium under gravity (World::settle: Newton static solve, then damped relaxation; velocities zero), so the co-simulation does not start with the organ swinging into place; an organ with no fixed node cannot settle (fmi2Error)"),
         GRASP = Variable::boolean("grasp", Input, Discrete, false, "Grasp: while true the tool holds the tissue within reach of its surface (compliant attachments; the pull shows in force_*); at each communication step a tool that holds nothing grasps what is within reach, and false releases"),
         GRASPED_COUNT = Variable::integer("grasped_count", Output, Discrete, None, Some(0), None, "Number of organ particles the tool holds at the end of the step (0 when not grasping)"),
+        NEEDLE_PUNCTURE_FORCE = param("needle_puncture_force", Fixed, "N", 0.0, Some(0.0), "Above 0 the tool (a capsule or cylinder; shaft along its local y, tip at +y) is a needle: it punctures the organ when the tissue pushes back on its tip with this force, then holds the tissue on its shaft with friction (World::make_needle); 0 = an ordinary tool"),
+        NEEDLE_FRICTION = param("needle_friction", Fixed, "N/m", 10.0, Some(0.0), "Axial friction of an inserted needle per metre of inserted length"),
+        NEEDLE_DEPTH = output("needle_depth", "m", "How far the needle's tip is past its entry point along the shaft at the end of the step (0 before puncture, after withdrawal, or when the tool is not a needle)"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -163,6 +166,7 @@ pub static UNITS: &[UnitDefinition] = &[
     unit("1/s", 0, 0, -1),
     unit("N", 1, 1, -2),
     unit("N.m", 1, 2, -2),
+    unit("N/m", 1, 0, -2),
     unit("Pa", 1, -1, -2),
     unit("1/Pa", -1, 1, 2),
     unit("kg/m3", 1, -3, 0),
@@ -569,6 +573,15 @@ fn build(store: &Store, resources: Option<&Path>, log: &Logger) -> Result<Sim, S
             },
         )
         .map_err(e)?;
+    let puncture_force = store.real(vr::NEEDLE_PUNCTURE_FORCE);
+    if puncture_force > 0.0 {
+        let needle = NeedleOptions {
+            puncture_force,
+            friction_per_length: store.real(vr::NEEDLE_FRICTION),
+            reach: None,
+        };
+        world.make_needle(tool, &needle).map_err(e)?;
+    }
     let b = world.body(body).map_err(e)?;
     log.info(&format!(
         "world built: mesh \"{mesh_name}\" ({} nodes, {} tets, rest volume {:e} m3), {fixed} nodes fixed, tool {shape:?}",
@@ -615,6 +628,11 @@ fn write_outputs(
     store.set_integer(vr::CONTACT_COUNT, wrench.contact_count as i32);
     let held = sim.world.grasped_count(sim.tool).map_err(e)?;
     store.set_integer(vr::GRASPED_COUNT, held as i32);
+    let depth = match sim.world.needle_state(sim.tool) {
+        Ok(state) => state.inserted_length,
+        Err(_) => 0.0,
+    };
+    store.set_real(vr::NEEDLE_DEPTH, depth);
     Ok(())
 }
 

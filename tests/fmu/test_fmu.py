@@ -703,3 +703,41 @@ def test_grasp_holds_the_tissue_and_release_lets_go(slaves, vr):
         t += H
     assert fmu.getInteger([vr["grasped_count"]])[0] == 0
     assert abs(fmu.getReal([vr["force_z"]])[0]) < 0.1 * abs(force)
+
+
+def test_a_needle_punctures_at_its_force_and_reports_its_depth(slaves, vr):
+    """A 1 mm capsule needle pointing -z (local +y turned onto -z), puncture force 0.3 N,
+    pushed into the settled organ at 5 cm/s: before puncture the tissue pushes back on it
+    (force_z > 0) and needle_depth is 0; it punctures, and its depth then follows the travel
+    past the entry point; a plain probe never reports a depth."""
+    half, radius = 0.03, 0.001
+    c, s = math.cos(-math.pi / 4), math.sin(-math.pi / 4)
+    fmu = slaves.initialised(settle=True, tool_shape=1, tool_radius=radius,
+                             tool_half_length=half, needle_puncture_force=0.3,
+                             needle_friction=10.0, tool_qw=c, tool_qx=s,
+                             tool_pz=Z_OUT + half + radius)
+    t, z = 0.0, Z_OUT + half + radius
+    pushed_back, entry = 0.0, None
+    while z > Z_IN - 0.04:
+        z -= 0.0005
+        fmu.setReal([vr["tool_pz"]], [z])
+        fmu.doStep(t, H)
+        t += H
+        depth = fmu.getReal([vr["needle_depth"]])[0]
+        if entry is None:
+            if depth > 0.0:
+                entry = z
+            else:
+                pushed_back = max(pushed_back, fmu.getReal([vr["force_z"]])[0])
+        elif entry - z > 0.01:
+            break
+    assert entry is not None, "the needle never punctured"
+    print(f"needle: largest push-back before puncture {pushed_back:.3f} N; "
+          f"{depth * 1e3:.1f} mm deep after {(entry - z) * 1e3:.1f} mm more travel")
+    assert 0.2 < pushed_back < 0.45, "the tissue pushes back up to about the puncture force"
+    assert abs(depth - (entry - z)) < 0.003, "the depth follows the travel past the entry"
+    probe = slaves.initialised(settle=True)
+    probe.setReal([vr["tool_pz"]], [Z_IN])
+    probe.doStep(0.0, H)
+    assert probe.getReal([vr["needle_depth"]])[0] == 0.0
+
