@@ -127,8 +127,8 @@ pub struct BodyOptions {
     /// Target number of neighbours when the support radius is chosen automatically.
     pub target_neighbours: u32,
     /// Contact radius of the particles (m) for organ–organ contact and the sampled-points tool
-    /// contact, and the thickness of the contact skin over the boundary surface that tools touch
-    /// in the exact-shape mode; `None` takes half the mean tetrahedron edge.
+    /// contact (tools in the exact-shape mode touch the boundary triangles, with a skin of a
+    /// tenth of this radius); `None` takes half the mean tetrahedron edge.
     pub particle_radius: Option<Real>,
     /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
     /// divergence theorem (variationally consistent integration, Chen, Hillman & Rüter 2013): a
@@ -475,7 +475,7 @@ impl Body {
         self.particle_radius
     }
     /// Thickness of the contact skin over the boundary surface (m): tools in the exact-shape
-    /// contact mode touch the surface this far out of it (the particle radius).
+    /// contact mode touch the surface this far out of it (a tenth of the particle radius).
     pub fn contact_skin(&self) -> Real {
         crate::solver::SURFACE_SKIN * self.particle_radius
     }

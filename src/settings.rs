@@ -9,7 +9,7 @@ pub enum ContactMode {
     /// The tool's exact shape against the body's deformed boundary triangles (GJK), the
     /// correction spread over each triangle's particles by barycentric weights, one-sided and
     /// swept so that a tool thinner than the particle spacing neither slips between particles
-    /// nor tunnels. Contact starts a skin of one particle radius out from the
+    /// nor tunnels. Contact starts a skin of a tenth of the particle radius out from the
     /// surface. The default.
     ExactShape,
     /// The paper's mode: the tool surface sampled into points, each a sphere of radius equal to

@@ -208,8 +208,8 @@ fn slide(angle: Real, mu_s: Real, mu_k: Real, steps: usize) -> Vec<Real> {
     let mut world = World::new(settings).unwrap();
     let tilt = Quat::from_axis_angle(&Vec3::z_axis(), angle);
     let mut mesh = block();
-    // The contact skin: the default particle radius, half the mean edge.
-    let r = 0.5 * mesh.mean_edge_length();
+    // The contact skin: a tenth of the default particle radius of half the mean edge.
+    let r = 0.1 * 0.5 * mesh.mean_edge_length();
     // Block resting on the plate's top face (plate frame y = 0), the skin above it.
     for p in &mut mesh.nodes {
         *p = tilt * (*p + Vec3::new(0.0, r, 0.0));
