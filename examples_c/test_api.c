@@ -728,10 +728,11 @@ int main(void) {
         CHECK(memcmp(&got, &above, sizeof got) == 0);
     }
 
-    /* ---- stepping: press the sphere gently into the lattice (0.1 m/s, 30 steps, from 0.5 mm
-     * above the top face to 2.5 mm into it), then hold it there for TS_STEPS steps ---- */
+    /* ---- stepping: press the sphere gently into the lattice (0.1 m/s, 60 steps, from 0.5 mm
+     * above the top face to 5.5 mm into it, while the lattice sags under gravity), then hold
+     * it there for TS_STEPS steps ---- */
     ts_step_report report = {0, 0};
-    const long press = 30;
+    const long press = 60;
     for (long s = 0; s < press + steps; s++) {
         ts_pose p = above;
         long k = s < press ? s + 1 : press;
