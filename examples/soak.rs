@@ -120,7 +120,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             w.set_tool_pose(t, pose)?;
             match w.step() {
                 Ok(_) => {}
-                Err(Error::Diverged(_)) => {
+                Err(Error::Diverged(reason)) => {
+                    if diverged < 3 {
+                        eprintln!("  step {step}: {reason}");
+                    }
                     diverged += 1;
                     // The documented remedy: restore the last good state.
                     if diverged % 10 == 0 {

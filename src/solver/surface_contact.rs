@@ -45,6 +45,14 @@ pub(crate) const SURFACE_SKIN: Real = 0.1;
 /// Most Gauss–Seidel passes over the triangles near a tool per projection.
 pub(crate) const MAX_SURFACE_PASSES: usize = 8;
 
+/// Most a corner moves per contact correction, in units of that correction. The point–triangle
+/// constraint moves corner `k` by `b_k w_k / Σ b_j² w_j` times the correction (`b` barycentric
+/// weights, `w` inverse masses): at most ~1.4 for equal masses, but without bound when the
+/// contact point sits next to a fixed corner (the free corner, at a tiny `b`, would be flung by
+/// `1/b`; the soak run saw particles at 1e13 m/s). What the cap keeps the contact point from
+/// achieving stays as residual penetration, like the depenetration cap's.
+pub(crate) const MAX_CORNER_SHARE: Real = 2.0;
+
 /// The passes stop when the largest correction of a pass is below this fraction of the skin.
 pub(crate) const SURFACE_PASS_TOLERANCE: Real = 0.01;
 
@@ -228,9 +236,15 @@ pub(crate) fn project_tool_surface(
             let relative = moved + normal_shift - tool_motion;
             let shift = normal_shift
                 + friction_correction(&relative, &contact.direction, applied, mu_s, mu_k);
+            let shares: [Real; 3] =
+                std::array::from_fn(|k| (weights[k] * w[k] / denominator).min(MAX_CORNER_SHARE));
+            // What the cap on the shares keeps the contact point from achieving stays as
+            // residual penetration, like the depenetration cap's: not retried in the later passes.
+            let achieved: Real = (0..3).map(|k| weights[k] * shares[k]).sum();
+            *left += applied * (1.0 - achieved).max(0.0);
             let mut impulse = Vec3::zeros();
             for k in 0..3 {
-                let dp = shift * (weights[k] * w[k] / denominator);
+                let dp = shift * shares[k];
                 body.p[corners[k]] += dp;
                 impulse += dp * body.inertial_mass[corners[k]];
             }
