@@ -214,6 +214,54 @@ impl Default for BodyOptions {
     }
 }
 
+/// The dynamic state of a body's particles: what a step advances, what a diverged step's
+/// rollback restores, and what [`World::save_state`](crate::World::save_state) writes (with
+/// the tools' state and the time).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ParticleState {
+    /// Positions (m).
+    pub(crate) x: Vec<Vec3>,
+    /// Velocities (m/s).
+    pub(crate) v: Vec<Vec3>,
+    /// Per-particle rotation of the corotated model, warm start of the next extraction.
+    pub(crate) rotation: Vec<Quat>,
+}
+
+impl ParticleState {
+    /// Particles at `positions` (m), at rest and unrotated.
+    fn at_rest(positions: &[Vec3]) -> Self {
+        let n = positions.len();
+        ParticleState {
+            x: positions.to_vec(),
+            v: vec![Vec3::zeros(); n],
+            rotation: vec![Quat::identity(); n],
+        }
+    }
+
+    /// Overwrite with `other` (the same particle count) without allocating.
+    pub(crate) fn copy_from(&mut self, other: &ParticleState) {
+        self.x.copy_from_slice(&other.x);
+        self.v.copy_from_slice(&other.v);
+        self.rotation.copy_from_slice(&other.rotation);
+    }
+}
+
+/// A body's working memory of a step, sized once and reused, so that a step allocates nothing;
+/// nothing in it outlives a substep.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StepScratch {
+    /// Predicted positions of the current substep (m).
+    pub(crate) p: Vec<Vec3>,
+    /// Forces of the current substep (N).
+    pub(crate) force: Vec<Vec3>,
+    /// Per-pair forces of the force computation (N), one entry per neighbour pair.
+    pub(crate) pair_force: Vec<Vec3>,
+    /// Per-particle sums of their pair forces (N), for the multi-threaded force pass.
+    pub(crate) own_force: Vec<Vec3>,
+    /// XPBD multipliers of the volume constraints within a substep (one per tetrahedron).
+    pub(crate) tet_lambda: Vec<Real>,
+}
+
 /// A deformable body (see the module documentation).
 ///
 /// Data are laid out as flat arrays (one entry per particle, per pair in CSR, per tetrahedron)
@@ -224,18 +272,10 @@ pub struct Body {
     pub(crate) model: ElasticModel,
     /// Rest positions (m).
     pub(crate) rest: Vec<Vec3>,
-    /// Positions (m).
-    pub(crate) x: Vec<Vec3>,
-    /// Velocities (m/s).
-    pub(crate) v: Vec<Vec3>,
-    /// Predicted positions of the current substep (m); scratch.
-    pub(crate) p: Vec<Vec3>,
-    /// Forces of the current substep (N); scratch.
-    pub(crate) force: Vec<Vec3>,
-    /// Per-pair forces of the force computation (N), one entry per neighbour pair; scratch.
-    pub(crate) pair_force: Vec<Vec3>,
-    /// Per-particle sums of their pair forces (N); scratch of the multi-threaded force pass.
-    pub(crate) own_force: Vec<Vec3>,
+    /// Positions, velocities and rotations of the particles: what a step advances.
+    pub(crate) state: ParticleState,
+    /// What a substep computes and throws away: predicted positions, forces, multipliers.
+    pub(crate) scratch: StepScratch,
     /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
     pub(crate) mass: Vec<Real>,
     /// Inertial masses (kg): the physical mass plus any mass scaling.
@@ -246,14 +286,10 @@ pub struct Body {
     pub(crate) fixed: Vec<bool>,
     /// Particle volumes (m³).
     pub(crate) particle_volume: Vec<Real>,
-    /// Per-particle rotation of the corotated model, warm start of the next extraction.
-    pub(crate) rotation: Vec<Quat>,
     pub(crate) nbr: Neighbourhoods,
     pub(crate) tets: Vec<[u32; 4]>,
     /// Tetrahedron rest volumes (m³).
     pub(crate) tet_rest_volume: Vec<Real>,
-    /// XPBD multipliers of the volume constraints within a substep; scratch.
-    pub(crate) tet_lambda: Vec<Real>,
     pub(crate) boundary: Vec<[u32; 3]>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::cut::CutState>>,
@@ -270,10 +306,8 @@ pub struct Body {
     pub(crate) volume_constraints_on: bool,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
-    /// Copies of `x`, `v`, `rotation` taken at the start of a step, restored if it diverges.
-    pub(crate) saved_x: Vec<Vec3>,
-    pub(crate) saved_v: Vec<Vec3>,
-    pub(crate) saved_rotation: Vec<Quat>,
+    /// `state` as it was at the start of the step, restored if the step diverges.
+    pub(crate) saved: ParticleState,
 }
 
 /// Newton iterations of the rotation extraction per particle per substep before the exact SVD
@@ -337,21 +371,21 @@ impl Body {
             material: *m,
             model: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
             rest: mesh.nodes.clone(),
-            x: mesh.nodes.clone(),
-            v: vec![Vec3::zeros(); n],
-            p: mesh.nodes.clone(),
-            force: vec![Vec3::zeros(); n],
-            pair_force: vec![Vec3::zeros(); nbr.pair_count()],
-            own_force: vec![Vec3::zeros(); n],
+            state: ParticleState::at_rest(&mesh.nodes),
+            scratch: StepScratch {
+                p: mesh.nodes.clone(),
+                force: vec![Vec3::zeros(); n],
+                pair_force: vec![Vec3::zeros(); nbr.pair_count()],
+                own_force: vec![Vec3::zeros(); n],
+                tet_lambda: vec![0.0; mesh.tets.len()],
+            },
             inv_mass: vec![0.0; n],
             inertial_mass: mass.clone(),
             mass,
             fixed: vec![false; n],
             particle_volume,
-            rotation: vec![Quat::identity(); n],
             nbr,
             rest_volume: tet_rest_volume.iter().sum(),
-            tet_lambda: vec![0.0; mesh.tets.len()],
             tet_rest_volume,
             tets: mesh.tets.clone(),
             boundary,
@@ -362,9 +396,7 @@ impl Body {
             omega_max: 0.0,
             volume_compliance: 0.0,
             volume_constraints_on: false,
-            saved_x: mesh.nodes.clone(),
-            saved_v: vec![Vec3::zeros(); n],
-            saved_rotation: vec![Quat::identity(); n],
+            saved: ParticleState::at_rest(&mesh.nodes),
         };
         body.configure(settings);
         Ok(body)
@@ -401,15 +433,15 @@ impl Body {
 
     /// Number of particles (= mesh nodes).
     pub fn particle_count(&self) -> usize {
-        self.x.len()
+        self.state.x.len()
     }
     /// Current particle positions (m), one per particle.
     pub fn positions(&self) -> &[Vec3] {
-        &self.x
+        &self.state.x
     }
     /// Current particle velocities (m/s), one per particle.
     pub fn velocities(&self) -> &[Vec3] {
-        &self.v
+        &self.state.v
     }
     /// Rest positions (m), one per particle.
     pub fn rest_positions(&self) -> &[Vec3] {
@@ -444,11 +476,11 @@ impl Body {
     /// winding number about the point is above one half). Cost: one pass over the boundary
     /// triangles.
     pub fn contains(&self, point: &Vec3) -> bool {
-        crate::collision::winding::inside_surface(point, &self.x, &self.boundary)
+        crate::collision::winding::inside_surface(point, &self.state.x, &self.boundary)
     }
     /// Current volume (m³): the sum of the signed tetrahedron volumes.
     pub fn volume(&self) -> Real {
-        volume_of(&self.x, &self.tets)
+        volume_of(&self.state.x, &self.tets)
     }
     /// Rest volume (m³).
     pub fn rest_volume(&self) -> Real {
@@ -460,7 +492,8 @@ impl Body {
     }
     /// Largest distance of a particle from its rest position (m).
     pub fn max_displacement(&self) -> Real {
-        self.x
+        self.state
+            .x
             .iter()
             .zip(&self.rest)
             .map(|(x, r)| (x - r).norm())
@@ -506,11 +539,11 @@ impl Body {
     /// Elastic (and hourglass) forces (N) on every particle if the particles were at
     /// `positions` (m) with zero velocity; an analysis helper that allocates.
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
-        let mut force = vec![Vec3::zeros(); self.x.len()];
-        let mut rotation = vec![Quat::identity(); self.x.len()];
+        let mut force = vec![Vec3::zeros(); self.state.x.len()];
+        let mut rotation = vec![Quat::identity(); self.state.x.len()];
         let mut pair_force = vec![Vec3::zeros(); self.nbr.pair_count()];
-        let mut own_force = vec![Vec3::zeros(); self.x.len()];
-        let zero = vec![Vec3::zeros(); self.x.len()];
+        let mut own_force = vec![Vec3::zeros(); self.state.x.len()];
+        let zero = vec![Vec3::zeros(); self.state.x.len()];
         let input = ForceInputs {
             nbr: &self.nbr,
             volume: &self.particle_volume,
@@ -584,7 +617,7 @@ impl Body {
     }
 
     pub(crate) fn update_inverse_masses(&mut self) {
-        for i in 0..self.x.len() {
+        for i in 0..self.state.x.len() {
             self.inv_mass[i] = if self.fixed[i] {
                 0.0
             } else {
@@ -597,7 +630,7 @@ impl Body {
     /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms.
     pub(crate) fn diagonal_stiffness(&self) -> Vec<Real> {
         let pwave = self.model.p_wave_modulus();
-        let mut k = vec![0.0; self.x.len()];
+        let mut k = vec![0.0; self.state.x.len()];
         for (i, vi) in self.particle_volume.iter().enumerate() {
             let mut dsum = Vec3::zeros();
             for e in self.nbr.range(i) {
@@ -617,7 +650,7 @@ impl Body {
     pub(crate) fn fix(&mut self, i: usize) {
         self.fixed[i] = true;
         self.inv_mass[i] = 0.0;
-        self.v[i] = Vec3::zeros();
+        self.state.v[i] = Vec3::zeros();
     }
 }
 

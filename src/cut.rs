@@ -133,7 +133,7 @@ fn crosses(p: &Vec3, q: &Vec3, tris: &[[Vec3; 3]; 2], lo: &Vec3, hi: &Vec3) -> b
 /// changes nothing.
 pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
     let (tris, lo, hi) = swept(blade);
-    let x = &body.x;
+    let x = &body.state.x;
     let nbr = &body.nbr;
     let already = |e: usize| body.cuts.as_ref().is_some_and(|c| c.pair_cut[e]);
     let mut new_pairs = Vec::new();
@@ -182,7 +182,7 @@ pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
 /// in `changed`), the tetrahedra, the rest volume, the boundary and the stability data. Returns
 /// the number of particles left without elasticity among those recomputed.
 fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> usize {
-    let n = body.x.len();
+    let n = body.state.x.len();
     let mut rows = vec![false; n];
     match changed {
         Some(pairs) => {
@@ -217,7 +217,7 @@ fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> us
         }
     }
     // Within the load-time capacity: no allocation.
-    body.tet_lambda.resize(body.tets.len(), 0.0);
+    body.scratch.tet_lambda.resize(body.tets.len(), 0.0);
     body.rest_volume = body.tet_rest_volume.iter().sum();
     let mesh = TetMesh {
         nodes: body.rest.clone(),

@@ -3,7 +3,7 @@
 //! rolled back. O(particles + tetrahedra) per body.
 //!
 //! The extent and volume bounds fail a step only when it moves the body farther out of them
-//! than it was at the start of the step (`Body::saved_x`): a body set into an inverted or
+//! than it was at the start of the step (`Body::saved`): a body set into an inverted or
 //! flattened state on purpose recovers through states outside the volume range, and each of
 //! those steps brings it closer.
 
@@ -16,7 +16,7 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
     let size = body.size;
     let max_speed = limits.max_speed * size;
     let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
-    for (i, (x, v)) in body.x.iter().zip(&body.v).enumerate() {
+    for (i, (x, v)) in body.state.x.iter().zip(&body.state.v).enumerate() {
         if !is_finite_vec(x) || !is_finite_vec(v) {
             return Some(format!("particle {i} became non-finite"));
         }
@@ -32,7 +32,7 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
         hi = hi.sup(x);
     }
     let extent = (hi - lo).norm() / size;
-    if extent > limits.max_extent_ratio && extent > extent_of(&body.saved_x) / size {
+    if extent > limits.max_extent_ratio && extent > extent_of(&body.saved.x) / size {
         return Some(format!(
             "the body spans {extent:.3e} times its rest size (limit {})",
             limits.max_extent_ratio
@@ -40,7 +40,7 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
     }
     let (min_ratio, max_ratio) = limits.volume_ratio;
     let ratio = body.volume_ratio();
-    let before = || volume_of(&body.saved_x, &body.tets) / body.rest_volume;
+    let before = || volume_of(&body.saved.x, &body.tets) / body.rest_volume;
     if (ratio < min_ratio && ratio < before()) || (ratio > max_ratio && ratio > before()) {
         return Some(format!(
             "its volume is {ratio:.3e} times the rest volume (accepted [{min_ratio}, {max_ratio}])"

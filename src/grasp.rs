@@ -133,7 +133,7 @@ impl Grasp {
                 .compliance
                 .unwrap_or(1.0 / (body.material.youngs_modulus * body.particle_radius));
             let limit = tool.bounding_radius + reach;
-            for (i, x) in body.x.iter().enumerate() {
+            for (i, x) in body.state.x.iter().enumerate() {
                 if body.inv_mass[i] == 0.0 || (x - tool.pose.position).norm() > limit {
                     continue;
                 }
@@ -176,12 +176,12 @@ impl Grasp {
                 continue;
             }
             let target = iso.transform_point(&Point::from(a.anchor)).coords;
-            let c = body.p[i] - target;
+            let c = body.scratch.p[i] - target;
             let alpha = a.compliance / (h * h);
             let dl = -(c + a.lambda * alpha) / (w + alpha);
             a.lambda += dl;
             let dp = dl * w;
-            body.p[i] += dp;
+            body.scratch.p[i] += dp;
             let impulse = dp * body.inertial_mass[i];
             tool.acc_impulse += impulse;
             tool.acc_moment += (target - cur.position).cross(&impulse);

@@ -192,7 +192,8 @@ impl Needle {
                     .iter()
                     .enumerate()
                     .filter_map(|(b, body)| {
-                        body.x
+                        body.state
+                            .x
                             .iter()
                             .map(|x| (x - tip).norm())
                             .min_by(Real::total_cmp)
@@ -229,7 +230,7 @@ impl Needle {
         for h in &mut self.holds {
             h.lambda = Vec3::zeros();
         }
-        for (i, x) in body.x.iter().enumerate() {
+        for (i, x) in body.state.x.iter().enumerate() {
             if body.inv_mass[i] == 0.0 {
                 continue;
             }
@@ -271,7 +272,7 @@ impl Needle {
             if w == 0.0 {
                 continue;
             }
-            let before = body.p[i];
+            let before = body.scratch.p[i];
             let local = iso.inverse_transform_point(&Point::from(before)).coords;
             // Lateral: towards the anchor's offset from the axis (local x, z).
             let c = Vec3::new(local.x - hold.anchor.x, 0.0, local.z - hold.anchor.z);
@@ -287,7 +288,7 @@ impl Needle {
                 hold.anchor.y = local.y + axial;
             }
             let dp = lateral_world + axis * axial;
-            body.p[i] += dp;
+            body.scratch.p[i] += dp;
             let impulse = dp * m;
             tool.acc_impulse += impulse;
             let at = iso.transform_point(&Point::from(hold.anchor)).coords;

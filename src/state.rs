@@ -160,9 +160,9 @@ impl World {
         w.f64(self.time);
         for b in &self.bodies {
             w.u32(b.particle_count() as u32);
-            b.x.iter().for_each(|p| w.vec3(p));
-            b.v.iter().for_each(|v| w.vec3(v));
-            b.rotation.iter().for_each(|q| w.quat(q));
+            b.state.x.iter().for_each(|p| w.vec3(p));
+            b.state.v.iter().for_each(|v| w.vec3(v));
+            b.state.rotation.iter().for_each(|q| w.quat(q));
         }
         for (t, (g, needle)) in self.tools.iter().zip(self.grasps.iter().zip(&self.needles)) {
             let Some(t) = t else { continue };
@@ -288,9 +288,9 @@ impl World {
         self.time = r.f64();
         for b in &mut self.bodies {
             r.u32();
-            b.x.iter_mut().for_each(|p| *p = r.vec3());
-            b.v.iter_mut().for_each(|v| *v = r.vec3());
-            b.rotation.iter_mut().for_each(|q| *q = r.quat());
+            b.state.x.iter_mut().for_each(|p| *p = r.vec3());
+            b.state.v.iter_mut().for_each(|v| *v = r.vec3());
+            b.state.rotation.iter_mut().for_each(|q| *q = r.quat());
         }
         let mut extras = extras.into_iter();
         let slots = self.grasps.iter_mut().zip(&mut self.needles);

@@ -450,7 +450,7 @@ fn newton(
 /// result is kept only if it converged (otherwise the positions are left as they were).
 /// Velocities are set to zero. Returns the iterations and the residual reached.
 pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error> {
-    let mut x = body.x.clone();
+    let mut x = body.state.x.clone();
     let mut iterations = 0;
     let res = newton(
         body,
@@ -463,14 +463,14 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error
     if res > SETTLE_TOLERANCE {
         // Not converged (a large sag): an unconverged iterate can hold strongly distorted
         // particles, so keep the starting positions and leave the work to the relaxation.
-        x.copy_from_slice(&body.x);
+        x.copy_from_slice(&body.state.x);
     }
-    body.x.copy_from_slice(&x);
-    body.p.copy_from_slice(&x);
-    body.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+    body.state.x.copy_from_slice(&x);
+    body.scratch.p.copy_from_slice(&x);
+    body.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
     for i in 0..x.len() {
         let f = crate::elastic::deformation_gradient(&body.nbr, &x, i);
-        body.rotation[i] = crate::elastic::rotation_from_svd(&f);
+        body.state.rotation[i] = crate::elastic::rotation_from_svd(&f);
     }
     Ok(StaticSolve {
         iterations,

@@ -177,8 +177,8 @@ impl World {
         for (i, (x, v)) in positions.iter().zip(velocities).enumerate() {
             body.check_state(i, x, v).map_err(Error::InvalidArgument)?;
         }
-        body.x.copy_from_slice(positions);
-        for ((v, given), fixed) in body.v.iter_mut().zip(velocities).zip(&body.fixed) {
+        body.state.x.copy_from_slice(positions);
+        for ((v, given), fixed) in body.state.v.iter_mut().zip(velocities).zip(&body.fixed) {
             *v = if *fixed { Vec3::zeros() } else { *given };
         }
         Ok(())
@@ -249,7 +249,7 @@ impl World {
         let body = self.body_mut(id)?;
         let inside: Vec<usize> = (0..body.particle_count())
             .filter(|&i| {
-                let p = body.x[i];
+                let p = body.state.x[i];
                 (0..3).all(|a| p[a] >= min[a] && p[a] <= max[a])
             })
             .collect();
@@ -500,14 +500,14 @@ impl World {
         let kinetic = |w: &World| -> Real {
             w.bodies
                 .iter()
-                .flat_map(|b| b.v.iter().zip(&b.inertial_mass))
+                .flat_map(|b| b.state.v.iter().zip(&b.inertial_mass))
                 .map(|(v, m)| m * v.norm_squared())
                 .sum()
         };
         let max_speed = |w: &World| -> Real {
             w.bodies
                 .iter()
-                .flat_map(|b| b.v.iter())
+                .flat_map(|b| b.state.v.iter())
                 .map(|v| v.norm())
                 .fold(0.0, Real::max)
         };
@@ -528,7 +528,7 @@ impl World {
             let k = kinetic(self);
             if k < previous {
                 for b in &mut self.bodies {
-                    b.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+                    b.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
                 }
                 previous = 0.0;
             } else {
@@ -536,7 +536,7 @@ impl World {
             }
         }
         for b in &mut self.bodies {
-            b.v.iter_mut().for_each(|v| *v = Vec3::zeros());
+            b.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
         }
         self.time = time;
         Ok(SettleReport {

@@ -4,7 +4,8 @@
 //! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
 //! limit of the stiffest body, at least `Settings::min_substeps`). Data flow of one step:
 //!
-//! 1. save `x`, `v`, rotations (the rollback copy); clear the tools' wrench accumulators;
+//! 1. copy each body's particle state (`x`, `v`, rotations: one `ParticleState` value) into
+//!    its rollback copy `saved`; clear the tools' wrench accumulators;
 //! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
@@ -13,13 +14,14 @@
 //!    tool samples against the particles; off between a needle and the body it punctured and
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
-//! 3. the divergence check (`crate::divergence`): a failure restores the rollback copy;
+//! 3. the divergence check (`crate::divergence`): a failure swaps the rollback copy back in;
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
 //!    poses, needle puncture or withdrawal, time.
 //!
 //! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation). The bodies own their state (`x`, `v`,
-//! rotations) and their scratch (`p`, forces, multipliers); the world owns the hash grid and
+//! substeps (linear position, slerp orientation). The bodies own their state (`state`:
+//! positions, velocities, rotations, and its rollback copy `saved`) and their
+//! `scratch` (predicted positions `p`, forces, multipliers); the world owns the hash grid and
 //! the thread pool.
 
 mod organ_contact;
@@ -46,9 +48,7 @@ impl World {
     pub fn step(&mut self) -> Result<StepReport, Error> {
         let (n, clamped) = self.substeps_needed();
         for b in &mut self.bodies {
-            b.saved_x.copy_from_slice(&b.x);
-            b.saved_v.copy_from_slice(&b.v);
-            b.saved_rotation.copy_from_slice(&b.rotation);
+            b.saved.copy_from(&b.state);
         }
         let h = self.settings.dt / n as Real;
         for t in self.tools.iter_mut().flatten() {
@@ -66,9 +66,9 @@ impl World {
             });
         if let Some((b, why)) = failure {
             for body in &mut self.bodies {
-                body.x.copy_from_slice(&body.saved_x);
-                body.v.copy_from_slice(&body.saved_v);
-                body.rotation.copy_from_slice(&body.saved_rotation);
+                // The state at the start of the step back as one value; `saved` is rewritten
+                // at the start of the next step.
+                std::mem::swap(&mut body.state, &mut body.saved);
             }
             self.diverged_steps += 1;
             return Err(Error::Diverged(format!(
@@ -145,7 +145,7 @@ impl World {
                     .map(|b| b.particle_radius)
                     .fold(0.0, Real::max);
             self.grid
-                .build(self.bodies.iter().map(|b| b.p.as_slice()), cell);
+                .build(self.bodies.iter().map(|b| b.scratch.p.as_slice()), cell);
         }
         for t in self.tools.iter_mut().flatten() {
             t.acc_contacts = 0;
@@ -229,9 +229,9 @@ impl World {
         }
         for body in &mut self.bodies {
             let inv_h = 1.0 / h;
-            for i in 0..body.x.len() {
-                body.v[i] = (body.p[i] - body.x[i]) * inv_h;
-                body.x[i] = body.p[i];
+            for i in 0..body.state.x.len() {
+                body.state.v[i] = (body.scratch.p[i] - body.state.x[i]) * inv_h;
+                body.state.x[i] = body.scratch.p[i];
             }
         }
     }

@@ -19,7 +19,7 @@ pub(crate) fn project_organ_contacts(
     let nb = bodies.len();
     for a in 0..nb {
         for i in 0..bodies[a].particle_count() {
-            let pi = bodies[a].p[i];
+            let pi = bodies[a].scratch.p[i];
             let friction = pair_friction;
             grid.for_each_near(&pi, |[b, j]| {
                 let (b, j) = (b as usize, j as usize);
@@ -36,20 +36,20 @@ pub(crate) fn project_organ_contacts(
                     }
                 }
                 let (wa, wb) = (bodies[a].inv_mass[i], bodies[b].inv_mass[j]);
-                let (mut pa, mut pb) = (bodies[a].p[i], bodies[b].p[j]);
+                let (mut pa, mut pb) = (bodies[a].scratch.p[i], bodies[b].scratch.p[j]);
                 let Some(c) = project_particle_particle(&mut pa, &mut pb, wa, wb, ra + rb) else {
                     return;
                 };
                 let key = (a.min(b) as u32, a.max(b) as u32);
                 if let Some(f) = friction.iter().find(|f| f.bodies == key) {
-                    let rel = (pa - bodies[a].x[i]) - (pb - bodies[b].x[j]);
+                    let rel = (pa - bodies[a].state.x[i]) - (pb - bodies[b].state.x[j]);
                     let dfr = friction_correction(&rel, &c.normal, c.depth, f.mu_s, f.mu_k);
                     let wsum = wa + wb;
                     pa += dfr * (wa / wsum);
                     pb -= dfr * (wb / wsum);
                 }
-                bodies[a].p[i] = pa;
-                bodies[b].p[j] = pb;
+                bodies[a].scratch.p[i] = pa;
+                bodies[b].scratch.p[j] = pb;
             });
         }
     }

@@ -7,34 +7,34 @@ use crate::parallel::Pool;
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s).
 pub(crate) fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real, pool: &Pool) {
-    for i in 0..body.x.len() {
-        body.force[i] = gravity * body.mass[i];
+    for i in 0..body.state.x.len() {
+        body.scratch.force[i] = gravity * body.mass[i];
     }
     let input = ForceInputs {
         nbr: &body.nbr,
         volume: &body.particle_volume,
-        x: &body.x,
-        v: &body.v,
+        x: &body.state.x,
+        v: &body.state.v,
     };
     accumulate_forces(
         &body.model,
         &input,
-        &mut body.rotation,
+        &mut body.state.rotation,
         ROTATION_ITERATIONS,
-        &mut body.pair_force,
-        &mut body.own_force,
-        &mut body.force,
+        &mut body.scratch.pair_force,
+        &mut body.scratch.own_force,
+        &mut body.scratch.force,
         pool,
     );
-    for i in 0..body.x.len() {
+    for i in 0..body.state.x.len() {
         let w = body.inv_mass[i];
         if body.fixed[i] {
-            body.v[i] = Vec3::zeros();
-            body.p[i] = body.x[i];
+            body.state.v[i] = Vec3::zeros();
+            body.scratch.p[i] = body.state.x[i];
         } else {
-            body.v[i] = body.v[i] * damping_factor + body.force[i] * (h * w);
-            body.p[i] = body.x[i] + body.v[i] * h;
+            body.state.v[i] = body.state.v[i] * damping_factor + body.scratch.force[i] * (h * w);
+            body.scratch.p[i] = body.state.x[i] + body.state.v[i] * h;
         }
     }
-    body.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
+    body.scratch.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
 }

@@ -27,11 +27,11 @@ pub(crate) fn project_sampled_contacts(
     let r = body.particle_radius;
     let reach = tool.bounding_radius + r;
     let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
-    for i in 0..body.x.len() {
+    for i in 0..body.state.x.len() {
         if body.inv_mass[i] == 0.0 {
             continue;
         }
-        let before = body.p[i];
+        let before = body.scratch.p[i];
         if (before - centre).norm_squared() > reach * reach {
             continue;
         }
@@ -40,7 +40,7 @@ pub(crate) fn project_sampled_contacts(
         let mut touched: Option<Vec3> = None;
         let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
             let tool_motion = contact - back.transform_point(&Point::from(contact)).coords;
-            let rel = (*p - body.x[i]) - tool_motion;
+            let rel = (*p - body.state.x[i]) - tool_motion;
             *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
             tool.acc_penetration = tool.acc_penetration.max(c.depth);
             touched = Some(contact);
@@ -60,7 +60,7 @@ pub(crate) fn project_sampled_contacts(
             if count {
                 tool.acc_contacts += 1;
             }
-            body.p[i] = p;
+            body.scratch.p[i] = p;
         }
     }
 }

@@ -161,7 +161,7 @@ pub(crate) fn project_tool_surface(
         if corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
             continue;
         }
-        let [a, b, c] = corners.map(|k| body.p[k]);
+        let [a, b, c] = corners.map(|k| body.scratch.p[k]);
         let centroid = (a + b + c) / 3.0;
         let extent = [a, b, c]
             .iter()
@@ -179,13 +179,13 @@ pub(crate) fn project_tool_surface(
         for (&t, left) in near.iter().zip(residual.iter_mut()) {
             let corners = body.boundary[t as usize].map(|k| k as usize);
             let w = corners.map(|k| body.inv_mass[k]);
-            let [a, b, c] = corners.map(|k| body.p[k]);
+            let [a, b, c] = corners.map(|k| body.scratch.p[k]);
             let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
                 continue;
             };
             // Which side the tool came from: its middle at the substep's start against the
             // triangle at the substep's start (before the iterations moved or turned it).
-            let [a0, b0, c0] = corners.map(|k| body.x[k]);
+            let [a0, b0, c0] = corners.map(|k| body.state.x[k]);
             let n0 = (b0 - a0).cross(&(c0 - a0)).try_normalize(0.0).unwrap_or(n);
             let middle_prev = middle(map, &iso_prev, &n0);
             let from_front = (middle_prev - a0).dot(&n0) >= 0.0;
@@ -209,7 +209,7 @@ pub(crate) fn project_tool_surface(
                 continue;
             }
             let moved: Vec3 = (0..3)
-                .map(|k| (body.p[corners[k]] - body.x[corners[k]]) * weights[k])
+                .map(|k| (body.scratch.p[corners[k]] - body.state.x[corners[k]]) * weights[k])
                 .sum();
             // The cap applies to penetration older than this substep: what the contact point's
             // predicted motion towards the tool (v h) brought in is removed whole. What the cap
@@ -218,13 +218,13 @@ pub(crate) fn project_tool_surface(
             // same cap.
             let depth = contact.depth;
             let applied = if pass == 0 {
-                let predicted: Vec3 = (0..3).map(|k| body.v[corners[k]] * weights[k]).sum();
+                let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
                 let towards_tool = (-predicted.dot(&contact.direction)).max(0.0) * h;
                 let applied = depth.min(max_correction + towards_tool);
                 *left = depth - applied;
                 applied
             } else {
-                let predicted: Vec3 = (0..3).map(|k| body.v[corners[k]] * weights[k]).sum();
+                let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
                 let towards_tool = (-predicted.dot(&contact.direction)).max(0.0) * h;
                 *left = left.min(depth);
                 (depth - *left).min(max_correction + towards_tool)
@@ -245,7 +245,7 @@ pub(crate) fn project_tool_surface(
             let mut impulse = Vec3::zeros();
             for k in 0..3 {
                 let dp = shift * shares[k];
-                body.p[corners[k]] += dp;
+                body.scratch.p[corners[k]] += dp;
                 impulse += dp * body.inertial_mass[corners[k]];
             }
             tool.acc_impulse += impulse;

@@ -15,12 +15,12 @@ pub(crate) fn project_volumes(body: &mut Body, h: Real) {
     for t in 0..body.tets.len() {
         let v0 = body.tet_rest_volume[t];
         project_volume_tet(
-            &mut body.p,
+            &mut body.scratch.p,
             &body.inv_mass,
             body.tets[t],
             v0,
             compliance_per_h2 * v0,
-            &mut body.tet_lambda[t],
+            &mut body.scratch.tet_lambda[t],
         );
     }
 }
