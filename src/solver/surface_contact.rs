@@ -217,17 +217,15 @@ pub(crate) fn project_tool_surface(
             // what the neighbouring triangles' corrections pushed in beyond it, each under the
             // same cap.
             let depth = contact.depth;
+            let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
+            let cap = max_correction + (-predicted.dot(&contact.direction)).max(0.0) * h;
             let applied = if pass == 0 {
-                let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
-                let towards_tool = (-predicted.dot(&contact.direction)).max(0.0) * h;
-                let applied = depth.min(max_correction + towards_tool);
+                let applied = depth.min(cap);
                 *left = depth - applied;
                 applied
             } else {
-                let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
-                let towards_tool = (-predicted.dot(&contact.direction)).max(0.0) * h;
                 *left = left.min(depth);
-                (depth - *left).min(max_correction + towards_tool)
+                (depth - *left).min(cap)
             };
             largest = largest.max(applied);
             let tool_motion =
