@@ -304,19 +304,14 @@ fn triangle_contact(
             depth,
         })
     };
-    let pos12 = iso.inverse();
     let mut simplex = VoronoiSimplex::new();
-    simplex.reset(CSOPoint::from_shapes(
-        &pos12,
-        map,
-        &triangle,
-        &pos12.translation.vector,
-    ));
-    let result = match gjk::closest_points(&pos12, map, &triangle, skin, true, &mut simplex) {
-        GJKResult::Intersection => match epa.closest_points(&pos12, map, &triangle, &simplex) {
-            Some((p1, p2, axis)) => GJKResult::ClosestPoints(p1, p2, axis),
-            None => return None,
-        },
+    let result = match gjk_at(iso, map, &triangle, skin, &mut simplex) {
+        GJKResult::Intersection => {
+            match epa.closest_points(&iso.inverse(), map, &triangle, &simplex) {
+                Some((p1, p2, axis)) => GJKResult::ClosestPoints(p1, p2, axis),
+                None => return None,
+            }
+        }
         other => other,
     };
     match result {
@@ -344,21 +339,32 @@ fn triangle_contact(
                 return None;
             }
             let crossing = Pose::interpolate(prev, cur, h0 / (h0 - h1)).isometry();
-            let at = crossing.inverse();
-            let mut simplex = VoronoiSimplex::new();
-            simplex.reset(CSOPoint::from_shapes(
-                &at,
-                map,
-                &triangle,
-                &at.translation.vector,
-            ));
-            match gjk::closest_points(&at, map, &triangle, skin, true, &mut simplex) {
+            match gjk_at(&crossing, map, &triangle, skin, &mut simplex) {
                 GJKResult::NoIntersection(_) | GJKResult::Proximity(_) => None,
                 _ => in_front(),
             }
         }
         _ => None,
     }
+}
+
+/// GJK between the tool (`map` at `iso`) and `triangle` (world frame, m) within `skin` (m),
+/// starting from a fresh `simplex`, which is left for EPA.
+fn gjk_at(
+    iso: &Isometry<Real>,
+    map: &dyn SupportMap,
+    triangle: &Triangle,
+    skin: Real,
+    simplex: &mut VoronoiSimplex,
+) -> GJKResult {
+    let pos12 = iso.inverse();
+    simplex.reset(CSOPoint::from_shapes(
+        &pos12,
+        map,
+        triangle,
+        &pos12.translation.vector,
+    ));
+    gjk::closest_points(&pos12, map, triangle, skin, true, simplex)
 }
 
 /// How far (m) the tool at `iso` reaches behind `point` along −`n`: the distance from `point`
