@@ -4,16 +4,22 @@
 //!
 //! ```text
 //! cargo run --release --example static_accuracy -- [--neighbours K] [--hourglass C]
-//!     [--nodal-volume] [--plain-mls] [SCENE ...]
+//!     [--nodal-volume] [--plain-mls] [--audit] [SCENE ...]
 //! ```
+//! `--audit` adds, per scene, the solution's best-fit scale against P2 (> 1: too soft) and the
+//! energy audit of `audit.rs`: the deviatoric energy of the P2 field as the particles see it,
+//! over what linear tetrahedra see, for the surface, interior and fixed particles.
 //! Scenes: `liver_1k6`, `liver_4k`, `liver_10k` (ν 0.3 and 0.45 each), `organ_c0133`,
 //! `organ_c0095`, `organ_c0068`, `cantilever` (ν 0.3, and 0.45 when its reference exists).
 //! A scene whose reference file is missing is reported and skipped.
 
+#[path = "static_accuracy/audit.rs"]
+mod audit;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use tissuesim::mesh::{self, TetMesh};
-use tissuesim::{statics, BodyOptions, Material, Real, Settings, Vec3, World};
+use tissuesim::{statics, Body, BodyOptions, Material, Real, Settings, Vec3, World};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
@@ -168,11 +174,28 @@ fn rel_l2(u: &[Vec3], ids: &[usize], reference: &HashMap<usize, Vec3>) -> Res<Re
     Ok((e / n).sqrt())
 }
 
+/// The best-fit scale of `u` against the reference and the energy audit of the reference field.
+fn print_audit(body: &Body, u: &[Vec3], scene: &Scene, reference: &HashMap<usize, Vec3>) {
+    let r: Vec<Vec3> = scene.ids.iter().map(|k| reference[k]).collect();
+    let dot = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(p, q)| p.dot(q)).sum::<Real>();
+    let scale = dot(u, &r) / dot(&r, &r);
+    let a = audit::audit(body, &r);
+    let ratio = |c: audit::ClassEnergy| c.particles / c.linear_tets;
+    println!(
+        "    scale {scale:.3}; P2 field's deviatoric energy, particles / linear tets: \
+         surface {:.2}, interior {:.2}, fixed {:.2}",
+        ratio(a.surface),
+        ratio(a.interior),
+        ratio(a.fixed)
+    );
+}
+
 fn main() -> Res<()> {
     let mut args = std::env::args().skip(1);
     let mut options = BodyOptions::default();
     let mut settings = Settings::default();
     let mut names = Vec::new();
+    let mut with_audit = false;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--neighbours" => options.target_neighbours = args.next().ok_or("K")?.parse()?,
@@ -180,6 +203,7 @@ fn main() -> Res<()> {
             "--nodal-volume" => settings.volume_constraints = false,
             "--tet-volume" => settings.volume_constraints = true,
             "--plain-mls" => options.consistent_gradients = false,
+            "--audit" => with_audit = true,
             s => names.push(s.to_string()),
         }
     }
@@ -219,6 +243,9 @@ fn main() -> Res<()> {
             .map(|v| format!("{:.1}%", 100.0 * v))
             .unwrap_or_else(|| "-".into());
         println!("{} | {:.1}% | {p1}", scene.name, 100.0 * e);
+        if with_audit {
+            print_audit(body, &u, &scene, &reference);
+        }
     }
     Ok(())
 }
