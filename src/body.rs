@@ -1,14 +1,15 @@
-//! A deformable body: particles at the mesh nodes, their neighbourhoods with the rest-state
-//! quantities precomputed, the tetrahedra for volume conservation, and the material.
+//! A deformable body in a world: its shared load-time model ([`BodyModel`]: rest data,
+//! neighbourhoods, masses), the elastic constants and mass scaling under the world's settings,
+//! the fixed particles, the particle state, its rollback copy and the step's scratch memory.
 
-use crate::consistency;
+use crate::body_model::BodyModel;
 use crate::elastic::{self, ElasticModel, ForceInputs};
 use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
-use crate::mesh::TetMesh;
-use crate::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::neighbours::{self, Neighbourhoods};
 use crate::parallel::Pool;
 use crate::settings::Settings;
+use std::sync::Arc;
 
 /// An isotropic linear-elastic material (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -268,37 +269,22 @@ pub(crate) struct StepScratch {
 /// so that the step streams through memory and allocates nothing.
 #[derive(Debug, Clone)]
 pub struct Body {
-    pub(crate) material: Material,
-    pub(crate) model: ElasticModel,
-    /// Rest positions (m).
-    pub(crate) rest: Vec<Vec3>,
+    /// The load-time data, shared with every other body built from the same model.
+    pub(crate) model: Arc<BodyModel>,
+    /// The elastic constants under the world's settings.
+    pub(crate) elastic: ElasticModel,
     /// Positions, velocities and rotations of the particles: what a step advances.
     pub(crate) state: ParticleState,
     /// What a substep computes and throws away: predicted positions, forces, multipliers.
     pub(crate) scratch: StepScratch,
-    /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
-    pub(crate) mass: Vec<Real>,
     /// Inertial masses (kg): the physical mass plus any mass scaling.
     pub(crate) inertial_mass: Vec<Real>,
     /// Inverse inertial masses (1/kg), 0 for fixed particles.
     pub(crate) inv_mass: Vec<Real>,
     /// Fixed flags.
     pub(crate) fixed: Vec<bool>,
-    /// Particle volumes (m³).
-    pub(crate) particle_volume: Vec<Real>,
-    pub(crate) nbr: Neighbourhoods,
-    pub(crate) tets: Vec<[u32; 4]>,
-    /// Tetrahedron rest volumes (m³).
-    pub(crate) tet_rest_volume: Vec<Real>,
-    pub(crate) boundary: Vec<[u32; 3]>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::cut::CutState>>,
-    pub(crate) particle_radius: Real,
-    /// Centre of the rest bounding box (m).
-    pub(crate) rest_centre: Vec3,
-    /// Diagonal of the rest bounding box (m): the body's size.
-    pub(crate) size: Real,
-    pub(crate) rest_volume: Real,
     /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
     /// split) disables them.
     pub(crate) volume_compliance: Real,
@@ -315,91 +301,32 @@ pub struct Body {
 pub(crate) const ROTATION_ITERATIONS: u32 = 6;
 
 impl Body {
-    /// Build a body from a cleaned mesh (positions in m) under the world's `settings`.
-    pub(crate) fn new(
-        mesh: &TetMesh,
-        options: &BodyOptions,
-        settings: &Settings,
-    ) -> Result<Body, Error> {
-        options.validate()?;
-        let m = &options.material;
-        let bad = |s: String| Err(Error::InvalidArgument(s));
-        let n = mesh.nodes.len();
-        if mesh.tets.is_empty() || n < 5 {
-            return bad("a body needs at least one tetrahedron and 5 nodes".into());
-        }
-        if let Some(k) = mesh.nodes.iter().position(|p| !is_finite_vec(p)) {
-            return Err(Error::NonFinite(format!("mesh node {k}")));
-        }
-        let mut particle_volume = vec![0.0; n];
-        let mut tet_rest_volume = Vec::with_capacity(mesh.tets.len());
-        for (t, tet) in mesh.tets.iter().enumerate() {
-            if tet.iter().any(|&k| k as usize >= n) {
-                return bad(format!("tetrahedron {t} references a node out of range"));
-            }
-            let [a, b, c, d] = tet.map(|k| mesh.nodes[k as usize]);
-            let vol = tet_volume(&a, &b, &c, &d);
-            if vol <= 0.0 {
-                return bad(format!("tetrahedron {t} is not positively oriented"));
-            }
-            tet_rest_volume.push(vol);
-            for &k in tet {
-                particle_volume[k as usize] += 0.25 * vol;
-            }
-        }
-        if let Some(k) = particle_volume.iter().position(|&v| v <= 0.0) {
-            return bad(format!("node {k} belongs to no tetrahedron"));
-        }
-        options.check_radii(mesh.mean_edge_length())?;
-        let support = match options.support_radius {
-            Some(h) => SupportRadius::Fixed(h),
-            None => SupportRadius::Automatic {
-                target: options.target_neighbours as usize,
-            },
-        };
-        let mut nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
-        let boundary = mesh.boundary_triangles();
-        if options.consistent_gradients {
-            consistency::correct_gradients(&mut nbr, &mesh.nodes, &particle_volume, &boundary);
-        }
-        let mass: Vec<Real> = particle_volume.iter().map(|v| v * m.density).collect();
-        let particle_radius = options
-            .particle_radius
-            .unwrap_or_else(|| 0.5 * mesh.mean_edge_length());
-        let (lo, hi) = mesh.bounding_box();
+    /// A body at rest, nothing fixed, on `model` (shared, not copied) under `settings`.
+    pub(crate) fn from_model(model: Arc<BodyModel>, settings: &Settings) -> Body {
+        let n = model.particle_count();
+        let m = model.options.material;
         let mut body = Body {
-            material: *m,
-            model: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
-            rest: mesh.nodes.clone(),
-            state: ParticleState::at_rest(&mesh.nodes),
+            elastic: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
+            state: ParticleState::at_rest(&model.rest),
             scratch: StepScratch {
-                p: mesh.nodes.clone(),
+                p: model.rest.clone(),
                 force: vec![Vec3::zeros(); n],
-                pair_force: vec![Vec3::zeros(); nbr.pair_count()],
+                pair_force: vec![Vec3::zeros(); model.nbr.pair_count()],
                 own_force: vec![Vec3::zeros(); n],
-                tet_lambda: vec![0.0; mesh.tets.len()],
+                tet_lambda: vec![0.0; model.tets.len()],
             },
             inv_mass: vec![0.0; n],
-            inertial_mass: mass.clone(),
-            mass,
+            inertial_mass: model.mass.clone(),
             fixed: vec![false; n],
-            particle_volume,
-            nbr,
-            rest_volume: tet_rest_volume.iter().sum(),
-            tet_rest_volume,
-            tets: mesh.tets.clone(),
-            boundary,
             cuts: None,
-            particle_radius,
-            rest_centre: (lo + hi) * 0.5,
-            size: (hi - lo).norm(),
             omega_max: 0.0,
             volume_compliance: 0.0,
             volume_constraints_on: false,
-            saved: ParticleState::at_rest(&mesh.nodes),
+            saved: ParticleState::at_rest(&model.rest),
+            model,
         };
         body.configure(settings);
-        Ok(body)
+        body
     }
 
     /// Check a particle state against [`STATE_POSITION_LIMIT`] and [`STATE_SPEED_LIMIT`]
@@ -412,8 +339,8 @@ impl Body {
             return Err(format!("particle {i}: non-finite velocity"));
         }
         let (d, far) = (
-            (x - self.rest_centre).norm(),
-            STATE_POSITION_LIMIT * self.size,
+            (x - self.model.rest_centre).norm(),
+            STATE_POSITION_LIMIT * self.model.size,
         );
         if d > far {
             return Err(format!(
@@ -421,7 +348,7 @@ impl Body {
                  of {far:.3e} m ({STATE_POSITION_LIMIT} body sizes)"
             ));
         }
-        let (speed, fast) = (v.norm(), STATE_SPEED_LIMIT * self.size);
+        let (speed, fast) = (v.norm(), STATE_SPEED_LIMIT * self.model.size);
         if speed > fast {
             return Err(format!(
                 "particle {i}: velocity {speed:.3e} m/s above the limit of {fast:.3e} m/s \
@@ -445,11 +372,11 @@ impl Body {
     }
     /// Rest positions (m), one per particle.
     pub fn rest_positions(&self) -> &[Vec3] {
-        &self.rest
+        &self.model.rest
     }
     /// Physical particle masses `ρ v_i` (kg), one per particle: gravity acts on these.
     pub fn masses(&self) -> &[Real] {
-        &self.mass
+        &self.model.mass
     }
     /// Inertial particle masses (kg), one per particle: the physical mass plus the mass added
     /// by [`Settings::mass_scaling`]. Momentum is `Σ inertial_mass · v`.
@@ -462,29 +389,35 @@ impl Body {
     }
     /// Tetrahedra (4 particle indices each).
     pub fn tets(&self) -> &[[u32; 4]] {
-        &self.tets
+        &self.model.tets
     }
     /// Boundary triangles of the tetrahedral mesh (3 particle indices each, outward normals).
     pub fn boundary_triangles(&self) -> &[[u32; 3]] {
-        &self.boundary
+        &self.model.boundary
+    }
+    /// The load-time model this body runs on: pass it to
+    /// [`World::add_body_model`](crate::World::add_body_model) to build the same body elsewhere
+    /// without redoing the load-time work.
+    pub fn model(&self) -> &Arc<BodyModel> {
+        &self.model
     }
     /// The neighbourhoods and their rest-state quantities.
     pub fn neighbourhoods(&self) -> &Neighbourhoods {
-        &self.nbr
+        &self.model.nbr
     }
     /// Whether `point` (m, world frame) is inside the body's deformed boundary surface (its
     /// winding number about the point is above one half). Cost: one pass over the boundary
     /// triangles.
     pub fn contains(&self, point: &Vec3) -> bool {
-        crate::collision::winding::inside_surface(point, &self.state.x, &self.boundary)
+        crate::collision::winding::inside_surface(point, &self.state.x, &self.model.boundary)
     }
     /// Current volume (m³): the sum of the signed tetrahedron volumes.
     pub fn volume(&self) -> Real {
-        volume_of(&self.state.x, &self.tets)
+        volume_of(&self.state.x, &self.model.tets)
     }
     /// Rest volume (m³).
     pub fn rest_volume(&self) -> Real {
-        self.rest_volume
+        self.model.rest_volume
     }
     /// `volume() / rest_volume()` (dimensionless).
     pub fn volume_ratio(&self) -> Real {
@@ -495,7 +428,7 @@ impl Body {
         self.state
             .x
             .iter()
-            .zip(&self.rest)
+            .zip(&self.model.rest)
             .map(|(x, r)| (x - r).norm())
             .fold(0.0, Real::max)
     }
@@ -505,25 +438,25 @@ impl Body {
     }
     /// Contact radius of the particles (m).
     pub fn particle_radius(&self) -> Real {
-        self.particle_radius
+        self.model.particle_radius
     }
     /// Thickness of the contact skin over the boundary surface (m): tools in the exact-shape
     /// contact mode touch the surface this far out of it (a tenth of the particle radius).
     pub fn contact_skin(&self) -> Real {
-        crate::solver::SURFACE_SKIN * self.particle_radius
+        crate::solver::SURFACE_SKIN * self.model.particle_radius
     }
     /// Total mass (kg).
     pub fn mass(&self) -> Real {
-        self.mass.iter().sum()
+        self.model.mass.iter().sum()
     }
     /// The elastic model in force: Lamé parameters of the particle stress (λ is 0 when the
     /// volumetric split moves it into the volume constraints), hourglass and damping terms.
     pub fn elastic_model(&self) -> &ElasticModel {
-        &self.model
+        &self.elastic
     }
     /// The material.
     pub fn material(&self) -> &Material {
-        &self.material
+        &self.model.options.material
     }
     /// Largest angular frequency (rad/s) of the body's linearised elastic vibrations at rest,
     /// the quantity that sets the explicit stability limit `2/ω_max` of a substep.
@@ -533,7 +466,7 @@ impl Body {
 
     /// Deformation gradient of particle `i` if the particles were at `positions` (m).
     pub fn deformation_gradient_at(&self, positions: &[Vec3], i: usize) -> Mat3 {
-        elastic::deformation_gradient(&self.nbr, positions, i)
+        elastic::deformation_gradient(&self.model.nbr, positions, i)
     }
 
     /// Elastic (and hourglass) forces (N) on every particle if the particles were at
@@ -541,17 +474,17 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.state.x.len()];
         let mut rotation = vec![Quat::identity(); self.state.x.len()];
-        let mut pair_force = vec![Vec3::zeros(); self.nbr.pair_count()];
+        let mut pair_force = vec![Vec3::zeros(); self.model.nbr.pair_count()];
         let mut own_force = vec![Vec3::zeros(); self.state.x.len()];
         let zero = vec![Vec3::zeros(); self.state.x.len()];
         let input = ForceInputs {
-            nbr: &self.nbr,
-            volume: &self.particle_volume,
+            nbr: &self.model.nbr,
+            volume: &self.model.particle_volume,
             x: positions,
             v: &zero,
         };
         elastic::accumulate_forces(
-            &self.model,
+            &self.elastic,
             &input,
             &mut rotation,
             50,
@@ -566,8 +499,8 @@ impl Body {
     /// Apply the world's settings: the elastic model's hourglass and damping terms, the mass
     /// scaling for substeps of `dt / min_substeps`, and the stability estimate.
     pub(crate) fn configure(&mut self, settings: &Settings) {
-        let m = self.material;
-        self.model = ElasticModel::new(
+        let m = self.model.options.material;
+        self.elastic = ElasticModel::new(
             m.youngs_modulus,
             m.poisson_ratio,
             settings.hourglass_stiffness,
@@ -576,10 +509,10 @@ impl Body {
         self.volume_compliance = settings.volume_compliance;
         self.volume_constraints_on = settings.volume_constraints;
         if settings.volume_constraints && settings.volumetric_split {
-            self.volume_compliance += 1.0 / self.model.lambda;
-            self.model.lambda = 0.0;
+            self.volume_compliance += 1.0 / self.elastic.lambda;
+            self.elastic.lambda = 0.0;
         }
-        self.inertial_mass.copy_from_slice(&self.mass);
+        self.inertial_mass.copy_from_slice(&self.model.mass);
         self.update_inverse_masses();
         self.omega_max = crate::stability::max_angular_frequency(
             self.rest_positions(),
@@ -600,7 +533,7 @@ impl Body {
                 for ((mi, m0), k) in self
                     .inertial_mass
                     .iter_mut()
-                    .zip(&self.mass)
+                    .zip(&self.model.mass)
                     .zip(&stiffness)
                 {
                     *mi = m0.max(factor * k / (omega_target * omega_target));
@@ -629,14 +562,14 @@ impl Body {
     /// An estimate (N/m) of each particle's diagonal stiffness at rest: the elastic terms of
     /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms.
     pub(crate) fn diagonal_stiffness(&self) -> Vec<Real> {
-        let pwave = self.model.p_wave_modulus();
+        let pwave = self.elastic.p_wave_modulus();
         let mut k = vec![0.0; self.state.x.len()];
-        for (i, vi) in self.particle_volume.iter().enumerate() {
+        for (i, vi) in self.model.particle_volume.iter().enumerate() {
             let mut dsum = Vec3::zeros();
-            for e in self.nbr.range(i) {
-                let j = self.nbr.index[e] as usize;
-                let d = self.nbr.gradient[e];
-                let hg = self.model.hourglass * vi * self.nbr.hourglass_weight[e];
+            for e in self.model.nbr.range(i) {
+                let j = self.model.nbr.index[e] as usize;
+                let d = self.model.nbr.gradient[e];
+                let hg = self.elastic.hourglass * vi * self.model.nbr.hourglass_weight[e];
                 k[j] += pwave * vi * d.norm_squared() + hg;
                 k[i] += hg;
                 dsum += d;

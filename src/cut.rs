@@ -22,8 +22,11 @@
 //! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
 
 use crate::body::Body;
+use crate::body_model::BodyModel;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
+use crate::neighbours::Neighbourhoods;
+use std::sync::Arc;
 
 /// A blade's edge at the start and at the end of its motion over one step (m, world frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,10 +54,9 @@ pub(crate) type CutSets = (Vec<u32>, Vec<u32>);
 /// Load-time data of a body, kept from its first cut on, and what has been cut.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct CutState {
-    gradient: Vec<Vec3>,
-    hourglass_weight: Vec<Real>,
-    tets: Vec<[u32; 4]>,
-    tet_rest_volume: Vec<Real>,
+    /// The model as loaded (shared with the other holders of it: the cut body works on its own
+    /// copy from the first cut on).
+    original: Arc<BodyModel>,
     /// Load-time inertial masses (kg) and diagonal stiffnesses (N/m) of the particles.
     inertial_mass: Vec<Real>,
     stiffness: Vec<Real>,
@@ -67,14 +69,11 @@ pub(crate) struct CutState {
 impl CutState {
     fn new(body: &Body) -> CutState {
         CutState {
-            gradient: body.nbr.gradient.clone(),
-            hourglass_weight: body.nbr.hourglass_weight.clone(),
-            tets: body.tets.clone(),
-            tet_rest_volume: body.tet_rest_volume.clone(),
+            original: Arc::clone(&body.model),
             inertial_mass: body.inertial_mass.clone(),
             stiffness: body.diagonal_stiffness(),
-            pair_cut: vec![false; body.nbr.pair_count()],
-            tet_cut: vec![false; body.tets.len()],
+            pair_cut: vec![false; body.model.nbr.pair_count()],
+            tet_cut: vec![false; body.model.tets.len()],
         }
     }
 }
@@ -134,7 +133,7 @@ fn crosses(p: &Vec3, q: &Vec3, tris: &[[Vec3; 3]; 2], lo: &Vec3, hi: &Vec3) -> b
 pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
     let (tris, lo, hi) = swept(blade);
     let x = &body.state.x;
-    let nbr = &body.nbr;
+    let nbr = &body.model.nbr;
     let already = |e: usize| body.cuts.as_ref().is_some_and(|c| c.pair_cut[e]);
     let mut new_pairs = Vec::new();
     for i in 0..x.len() {
@@ -146,7 +145,10 @@ pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
         }
     }
     let mut new_tets = Vec::new();
-    let original_tets = body.cuts.as_ref().map_or(&body.tets, |c| &c.tets);
+    let original_tets = body
+        .cuts
+        .as_ref()
+        .map_or(&body.model.tets, |c| &c.original.tets);
     for (t, tet) in original_tets.iter().enumerate() {
         if body.cuts.as_ref().is_some_and(|c| c.tet_cut[t]) {
             continue;
@@ -183,47 +185,51 @@ pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
 /// the number of particles left without elasticity among those recomputed.
 fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> usize {
     let n = body.state.x.len();
+    let original = &state.original;
+    // Copy-on-write: the first change of a shared model gives this body its own copy.
+    let model = Arc::make_mut(&mut body.model);
     let mut rows = vec![false; n];
     match changed {
         Some(pairs) => {
             for &e in pairs {
-                rows[centre_of(body, e)] = true;
+                rows[centre_of(&model.nbr, e)] = true;
             }
         }
         None => {
-            body.nbr.gradient.copy_from_slice(&state.gradient);
-            body.nbr
+            model.nbr.gradient.copy_from_slice(&original.nbr.gradient);
+            model
+                .nbr
                 .hourglass_weight
-                .copy_from_slice(&state.hourglass_weight);
+                .copy_from_slice(&original.nbr.hourglass_weight);
             for (e, &cut) in state.pair_cut.iter().enumerate() {
                 if cut {
-                    rows[centre_of(body, e)] = true;
+                    rows[centre_of(&model.nbr, e)] = true;
                 }
             }
         }
     }
     let mut isolated = 0;
     for (i, &row) in rows.iter().enumerate() {
-        if row && !recompute_row(body, &state.pair_cut, i) {
+        if row && !recompute_row(&mut model.nbr, &state.pair_cut, i) {
             isolated += 1;
         }
     }
-    body.tets.clear();
-    body.tet_rest_volume.clear();
-    for (t, tet) in state.tets.iter().enumerate() {
+    model.tets.clear();
+    model.tet_rest_volume.clear();
+    for (t, tet) in original.tets.iter().enumerate() {
         if !state.tet_cut[t] {
-            body.tets.push(*tet);
-            body.tet_rest_volume.push(state.tet_rest_volume[t]);
+            model.tets.push(*tet);
+            model.tet_rest_volume.push(original.tet_rest_volume[t]);
         }
     }
-    // Within the load-time capacity: no allocation.
-    body.scratch.tet_lambda.resize(body.tets.len(), 0.0);
-    body.rest_volume = body.tet_rest_volume.iter().sum();
+    model.rest_volume = model.tet_rest_volume.iter().sum();
     let mesh = TetMesh {
-        nodes: body.rest.clone(),
-        tets: body.tets.clone(),
+        nodes: model.rest.clone(),
+        tets: model.tets.clone(),
     };
-    body.boundary = mesh.boundary_triangles();
+    model.boundary = mesh.boundary_triangles();
+    // Within the load-time capacity: no allocation.
+    body.scratch.tet_lambda.resize(body.model.tets.len(), 0.0);
     restabilise(body, &state);
     body.cuts = Some(state);
     isolated
@@ -238,7 +244,7 @@ fn restabilise(body: &mut Body, state: &CutState) {
     let scaled = state
         .inertial_mass
         .iter()
-        .zip(&body.mass)
+        .zip(&body.model.mass)
         .any(|(mi, m)| mi > m);
     if scaled {
         let now = body.diagonal_stiffness();
@@ -258,15 +264,14 @@ fn restabilise(body: &mut Body, state: &CutState) {
 }
 
 /// The particle whose neighbourhood holds pair `e`.
-fn centre_of(body: &Body, e: usize) -> usize {
-    body.nbr.offsets.partition_point(|&o| o as usize <= e) - 1
+fn centre_of(nbr: &Neighbourhoods, e: usize) -> usize {
+    nbr.offsets.partition_point(|&o| o as usize <= e) - 1
 }
 
 /// Recompute particle `i`'s MLS gradients (poly6 kernel, its support radius) and hourglass
 /// weights from its uncut pairs; cut pairs get zeros. False (and all zeros) when fewer than
 /// [`MIN_NEIGHBOURS`] remain or the moment matrix is ill-conditioned.
-fn recompute_row(body: &mut Body, pair_cut: &[bool], i: usize) -> bool {
-    let nbr = &mut body.nbr;
+fn recompute_row(nbr: &mut Neighbourhoods, pair_cut: &[bool], i: usize) -> bool {
     let range = nbr.range(i);
     let h2 = nbr.support_radius[i] * nbr.support_radius[i];
     let weight = |u: &Vec3| {
@@ -346,8 +351,11 @@ pub(crate) fn restore(body: &mut Body, pairs: &[u32], tets: &[u32]) {
 
 /// Number of load-time pairs and tetrahedra of `body` (the ranges of the saved cut sets).
 pub(crate) fn load_time_counts(body: &Body) -> (usize, usize) {
-    let tets = body.cuts.as_ref().map_or(body.tets.len(), |c| c.tets.len());
-    (body.nbr.pair_count(), tets)
+    let tets = body
+        .cuts
+        .as_ref()
+        .map_or(body.model.tets.len(), |c| c.original.tets.len());
+    (body.model.nbr.pair_count(), tets)
 }
 
 impl Body {

@@ -13,7 +13,7 @@ use crate::settings::DivergenceLimits;
 
 /// Why `body` has diverged, or `None` when it is within `limits`.
 pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String> {
-    let size = body.size;
+    let size = body.model.size;
     let max_speed = limits.max_speed * size;
     let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
     for (i, (x, v)) in body.state.x.iter().zip(&body.state.v).enumerate() {
@@ -40,7 +40,7 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
     }
     let (min_ratio, max_ratio) = limits.volume_ratio;
     let ratio = body.volume_ratio();
-    let before = || volume_of(&body.saved.x, &body.tets) / body.rest_volume;
+    let before = || volume_of(&body.saved.x, &body.model.tets) / body.model.rest_volume;
     if (ratio < min_ratio && ratio < before()) || (ratio > max_ratio && ratio > before()) {
         return Some(format!(
             "its volume is {ratio:.3e} times the rest volume (accepted [{min_ratio}, {max_ratio}])"

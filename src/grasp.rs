@@ -128,10 +128,10 @@ impl Grasp {
         let iso = tool.pose.isometry();
         let mut attachments = Vec::new();
         for (b, body) in bodies.iter().enumerate() {
-            let reach = options.reach.unwrap_or(1.5 * body.particle_radius);
-            let compliance = options
-                .compliance
-                .unwrap_or(1.0 / (body.material.youngs_modulus * body.particle_radius));
+            let reach = options.reach.unwrap_or(1.5 * body.model.particle_radius);
+            let compliance = options.compliance.unwrap_or(
+                1.0 / (body.model.options.material.youngs_modulus * body.model.particle_radius),
+            );
             let limit = tool.bounding_radius + reach;
             for (i, x) in body.state.x.iter().enumerate() {
                 if body.inv_mass[i] == 0.0 || (x - tool.pose.position).norm() > limit {

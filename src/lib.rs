@@ -25,6 +25,7 @@
 #![warn(missing_docs)]
 
 pub(crate) mod body;
+pub(crate) mod body_model;
 pub(crate) mod collision;
 pub(crate) mod consistency;
 pub(crate) mod constraints;
@@ -52,6 +53,7 @@ pub use body::{
     PARTICLE_RADIUS_RANGE, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT, SUPPORT_RADIUS_RANGE,
     YOUNGS_MODULUS_RANGE,
 };
+pub use body_model::BodyModel;
 pub use collision::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,

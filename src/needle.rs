@@ -225,7 +225,7 @@ impl Needle {
         let reach = self
             .options
             .reach
-            .unwrap_or(self.radius + 1.5 * body.particle_radius);
+            .unwrap_or(self.radius + 1.5 * body.model.particle_radius);
         self.holds.retain(|h| h.anchor.y <= top);
         for h in &mut self.holds {
             h.lambda = Vec3::zeros();
@@ -261,7 +261,8 @@ impl Needle {
         }
         let iso = cur.isometry();
         let axis = Self::axis(cur);
-        let compliance = 1.0 / (body.material.youngs_modulus * body.particle_radius);
+        let compliance =
+            1.0 / (body.model.options.material.youngs_modulus * body.model.particle_radius);
         let alpha = compliance / (h * h);
         // Each held particle's share of the friction force (N).
         let length = self.inserted_length(cur).max(0.0);

@@ -78,7 +78,7 @@ impl BlockMatrix {
 /// blocks rotated by the particle's rotation `R_i` (`R_i K_i R_iᵀ`, stiffness warping) and
 /// the volume terms taken with the current tetrahedron gradients (Gauss–Newton).
 pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
-    let nbr = &body.nbr;
+    let nbr = &body.model.nbr;
     let n = body.particle_count();
     // Stencil of particle i: itself, then its neighbours.
     let stencils: Vec<Vec<u32>> = (0..n)
@@ -90,7 +90,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         .collect();
     let volume_stiffness = volume_stiffness_per_unit_volume(body);
     let tets: Vec<Vec<u32>> = if volume_stiffness > 0.0 {
-        body.tets.iter().map(|t| t.to_vec()).collect()
+        body.model.tets.iter().map(|t| t.to_vec()).collect()
     } else {
         Vec::new()
     };
@@ -101,7 +101,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
             .map(Vec::as_slice)
             .chain(tets.iter().map(Vec::as_slice)),
     );
-    let (lambda, mu, hourglass) = (body.model.lambda, body.model.mu, body.model.hourglass);
+    let (lambda, mu, hourglass) = (body.elastic.lambda, body.elastic.mu, body.elastic.hourglass);
     let mut c = Vec::new();
     let mut a = Vec::new();
     let rotations: Vec<Mat3> = match at {
@@ -116,7 +116,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         None => vec![Mat3::identity(); n],
     };
     for (i, stencil) in stencils.iter().enumerate() {
-        let vi = body.particle_volume[i];
+        let vi = body.model.particle_volume[i];
         let (r, rt) = (rotations[i], rotations[i].transpose());
         let range = nbr.range(i);
         // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
@@ -154,9 +154,9 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         }
     }
     if volume_stiffness > 0.0 {
-        for (t, tet) in body.tets.iter().enumerate() {
-            let g = volume_gradient(at.unwrap_or(&body.rest), tet);
-            let kt = volume_stiffness / body.tet_rest_volume[t];
+        for (t, tet) in body.model.tets.iter().enumerate() {
+            let g = volume_gradient(at.unwrap_or(&body.model.rest), tet);
+            let kt = volume_stiffness / body.model.tet_rest_volume[t];
             for p in 0..4 {
                 for q in 0..4 {
                     k.add(tet[p], tet[q], &(g[p] * g[q].transpose() * kt));
@@ -193,8 +193,8 @@ fn add_volume_forces(body: &Body, x: &[Vec3], force: &mut [Vec3]) {
     if stiffness == 0.0 {
         return;
     }
-    for (t, tet) in body.tets.iter().enumerate() {
-        let v0 = body.tet_rest_volume[t];
+    for (t, tet) in body.model.tets.iter().enumerate() {
+        let v0 = body.model.tet_rest_volume[t];
         let g = volume_gradient(x, tet);
         let [a, b, c, d] = tet.map(|k| x[k as usize]);
         let violation = crate::math::tet_volume(&a, &b, &c, &d) - v0;
@@ -339,7 +339,7 @@ pub fn linear_response(
 /// The linear (small-strain) static displacement (m) of `body` under gravity `g` (m/s²), its
 /// fixed particles held at rest: `K u = m g`.
 pub fn linear_gravity_sag(body: &Body, g: Vec3) -> Result<Vec<Vec3>, Error> {
-    let load: Vec<Vec3> = body.mass.iter().map(|m| g * *m).collect();
+    let load: Vec<Vec3> = body.model.mass.iter().map(|m| g * *m).collect();
     linear_response(body, &load, &vec![Vec3::zeros(); body.particle_count()])
 }
 
@@ -384,7 +384,7 @@ fn residual(body: &Body, x: &[Vec3], g: Vec3) -> Vec<Vec3> {
         if body.fixed[i] {
             *ri = Vec3::zeros();
         } else {
-            *ri += g * body.mass[i];
+            *ri += g * body.model.mass[i];
         }
     }
     r
@@ -406,6 +406,7 @@ fn newton(
     iterations: &mut u32,
 ) -> Result<Real, Error> {
     let weight = body
+        .model
         .mass
         .iter()
         .map(|m| (g * *m).norm_squared())
@@ -469,7 +470,7 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error
     body.scratch.p.copy_from_slice(&x);
     body.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
     for i in 0..x.len() {
-        let f = crate::elastic::deformation_gradient(&body.nbr, &x, i);
+        let f = crate::elastic::deformation_gradient(&body.model.nbr, &x, i);
         body.state.rotation[i] = crate::elastic::rotation_from_svd(&f);
     }
     Ok(StaticSolve {

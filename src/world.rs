@@ -2,6 +2,7 @@
 //! it. [`World::step`], Algorithm 1 of the paper, lives in the `solver` module, one pass a file.
 
 use crate::body::{Body, BodyOptions};
+use crate::body_model::BodyModel;
 use crate::collision::hash_grid::HashGrid;
 use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
@@ -13,6 +14,7 @@ use crate::needle::{Needle, NeedleOptions, NeedleState};
 use crate::parallel::Pool;
 use crate::render::{RenderMesh, RenderSurface};
 use crate::settings::Settings;
+use std::sync::Arc;
 
 /// Identifies a body inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -123,13 +125,20 @@ impl World {
     pub fn diverged_steps(&self) -> u64 {
         self.diverged_steps
     }
-    /// Add a deformable body built from `mesh` (node positions in m).
+    /// Add a deformable body built from `mesh` (node positions in m): [`BodyModel::new`]
+    /// then [`World::add_body_model`].
     pub fn add_body(&mut self, mesh: &TetMesh, options: &BodyOptions) -> Result<BodyId, Error> {
-        let body = Body::new(mesh, options, &self.settings)?;
-        self.bodies.push(body);
+        Ok(self.add_body_model(BodyModel::new(mesh, options)?))
+    }
+    /// Add a deformable body at rest on `model`, shared with its other holders (other worlds,
+    /// other bodies): the load-time work (neighbourhoods, consistent gradients) is not redone
+    /// and its arrays are not copied. Cutting the body gives it its own copy of the model
+    /// first; the other holders keep theirs.
+    pub fn add_body_model(&mut self, model: Arc<BodyModel>) -> BodyId {
+        self.bodies.push(Body::from_model(model, &self.settings));
         self.grid
             .reserve(self.bodies.iter().map(|b| b.particle_count()).sum());
-        Ok(BodyId(self.bodies.len() as u32 - 1))
+        BodyId(self.bodies.len() as u32 - 1)
     }
     /// Number of bodies.
     pub fn body_count(&self) -> usize {
@@ -449,7 +458,7 @@ impl World {
                 let xi = 0.5 * s.damping_stiffness * w;
                 h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
             }
-            radius = radius.min(b.particle_radius);
+            radius = radius.min(b.model.particle_radius);
         }
         let stable = (s.dt / (s.stability_margin * h_max)).ceil();
         let mut needed = if stable.is_finite() { stable as u32 } else { 1 };

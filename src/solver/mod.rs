@@ -142,7 +142,7 @@ impl World {
                 * self
                     .bodies
                     .iter()
-                    .map(|b| b.particle_radius)
+                    .map(|b| b.model.particle_radius)
                     .fold(0.0, Real::max);
             self.grid
                 .build(self.bodies.iter().map(|b| b.scratch.p.as_slice()), cell);

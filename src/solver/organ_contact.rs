@@ -26,11 +26,11 @@ pub(crate) fn project_organ_contacts(
                 if (b, j) <= (a, i) || (a == b && !self_contact) {
                     return;
                 }
-                let ra = bodies[a].particle_radius;
-                let rb = bodies[b].particle_radius;
+                let ra = bodies[a].model.particle_radius;
+                let rb = bodies[b].model.particle_radius;
                 if a == b {
                     // Particles close at rest belong to the same piece of tissue.
-                    let rest_d = (bodies[a].rest[i] - bodies[a].rest[j]).norm();
+                    let rest_d = (bodies[a].model.rest[i] - bodies[a].model.rest[j]).norm();
                     if rest_d < 2.0 * (ra + rb) {
                         return;
                     }

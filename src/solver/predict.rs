@@ -8,16 +8,16 @@ use crate::parallel::Pool;
 /// Forces, then the symplectic prediction of one body for a substep `h` (s).
 pub(crate) fn predict(body: &mut Body, gravity: Vec3, h: Real, damping_factor: Real, pool: &Pool) {
     for i in 0..body.state.x.len() {
-        body.scratch.force[i] = gravity * body.mass[i];
+        body.scratch.force[i] = gravity * body.model.mass[i];
     }
     let input = ForceInputs {
-        nbr: &body.nbr,
-        volume: &body.particle_volume,
+        nbr: &body.model.nbr,
+        volume: &body.model.particle_volume,
         x: &body.state.x,
         v: &body.state.v,
     };
     accumulate_forces(
-        &body.model,
+        &body.elastic,
         &input,
         &mut body.state.rotation,
         ROTATION_ITERATIONS,

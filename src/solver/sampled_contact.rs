@@ -24,7 +24,7 @@ pub(crate) fn project_sampled_contacts(
     // Maps a point attached to the tool at `cur` to where it was at `prev`.
     let back = prev.isometry() * iso.inverse();
     let centre = cur.position;
-    let r = body.particle_radius;
+    let r = body.model.particle_radius;
     let reach = tool.bounding_radius + r;
     let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
     for i in 0..body.state.x.len() {

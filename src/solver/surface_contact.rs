@@ -135,7 +135,7 @@ pub(crate) fn project_tool_surface(
     let iso_prev = prev.isometry();
     // Maps a point attached to the tool at `cur` to where it was at `prev`.
     let back = iso_prev * iso.inverse();
-    let skin = SURFACE_SKIN * body.particle_radius;
+    let skin = SURFACE_SKIN * body.model.particle_radius;
     let reach = tool.bounding_radius + skin;
     let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
     let hull = match &tool.description {
@@ -151,12 +151,12 @@ pub(crate) fn project_tool_surface(
     } = scratch;
     near.clear();
     residual.clear();
-    if near.capacity() < body.boundary.len() {
-        near.reserve(body.boundary.len());
-        residual.reserve(body.boundary.len());
+    if near.capacity() < body.model.boundary.len() {
+        near.reserve(body.model.boundary.len());
+        residual.reserve(body.model.boundary.len());
     }
     // Broad phase, once: the triangles with a free corner near the tool's path.
-    for (t, triangle) in body.boundary.iter().enumerate() {
+    for (t, triangle) in body.model.boundary.iter().enumerate() {
         let corners = triangle.map(|k| k as usize);
         if corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
             continue;
@@ -177,7 +177,7 @@ pub(crate) fn project_tool_surface(
     for pass in 0..MAX_SURFACE_PASSES {
         let mut largest: Real = 0.0;
         for (&t, left) in near.iter().zip(residual.iter_mut()) {
-            let corners = body.boundary[t as usize].map(|k| k as usize);
+            let corners = body.model.boundary[t as usize].map(|k| k as usize);
             let w = corners.map(|k| body.inv_mass[k]);
             let [a, b, c] = corners.map(|k| body.scratch.p[k]);
             let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {

@@ -12,12 +12,12 @@ pub(crate) fn project_volumes(body: &mut Body, h: Real) {
         return;
     }
     let compliance_per_h2 = body.volume_compliance / (h * h);
-    for t in 0..body.tets.len() {
-        let v0 = body.tet_rest_volume[t];
+    for t in 0..body.model.tets.len() {
+        let v0 = body.model.tet_rest_volume[t];
         project_volume_tet(
             &mut body.scratch.p,
             &body.inv_mass,
-            body.tets[t],
+            body.model.tets[t],
             v0,
             compliance_per_h2 * v0,
             &mut body.scratch.tet_lambda[t],

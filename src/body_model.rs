@@ -1,0 +1,157 @@
+//! The immutable part of a body: what a mesh and its [`BodyOptions`] determine once, at load
+//! time — rest positions, tetrahedra and their rest volumes, boundary triangles, particle
+//! volumes and masses, and the neighbourhoods with their (variationally consistent) gradient
+//! coefficients, the costly part of loading.
+//!
+//! A [`BodyModel`] is shared behind an [`Arc`]: every world (or FMU instance) built from the
+//! same mesh and options may hold the same one ([`World::add_body_model`](crate::World::add_body_model)).
+//! What the world's settings and the scene change — the elastic constants under the settings,
+//! the mass scaling, the fixed particles, the particle state — lives in [`Body`](crate::Body).
+//! A cut is the one operation that changes a model; it makes the cut body's own copy first
+//! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
+
+use crate::body::BodyOptions;
+use crate::consistency;
+use crate::error::Error;
+use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
+use crate::mesh::TetMesh;
+use crate::neighbours::{self, Neighbourhoods, SupportRadius};
+use std::sync::Arc;
+
+/// The load-time data of a body (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyModel {
+    /// The options it was built with (material, neighbourhood and contact settings).
+    pub(crate) options: BodyOptions,
+    /// Rest positions (m).
+    pub(crate) rest: Vec<Vec3>,
+    /// Physical particle masses `ρ v_i` (kg): gravity acts on these.
+    pub(crate) mass: Vec<Real>,
+    /// Particle volumes (m³): a quarter of each tetrahedron around the particle.
+    pub(crate) particle_volume: Vec<Real>,
+    pub(crate) nbr: Neighbourhoods,
+    pub(crate) tets: Vec<[u32; 4]>,
+    /// Tetrahedron rest volumes (m³).
+    pub(crate) tet_rest_volume: Vec<Real>,
+    /// Boundary triangles, outward normals.
+    pub(crate) boundary: Vec<[u32; 3]>,
+    /// Contact radius of the particles (m).
+    pub(crate) particle_radius: Real,
+    /// Centre of the rest bounding box (m).
+    pub(crate) rest_centre: Vec3,
+    /// Diagonal of the rest bounding box (m): the body's size.
+    pub(crate) size: Real,
+    /// Rest volume (m³).
+    pub(crate) rest_volume: Real,
+}
+
+impl BodyModel {
+    /// Build the model of a cleaned mesh (positions in m) with `options`: validates both,
+    /// computes the particle volumes, the neighbourhoods and their gradient coefficients.
+    ///
+    /// Errors: [`Error::InvalidArgument`] for invalid options, a mesh with fewer than one
+    /// tetrahedron or 5 nodes, an index out of range, a tetrahedron not positively oriented,
+    /// a node in no tetrahedron, or no well-conditioned neighbourhood; [`Error::NonFinite`]
+    /// for a non-finite node.
+    pub fn new(mesh: &TetMesh, options: &BodyOptions) -> Result<Arc<BodyModel>, Error> {
+        options.validate()?;
+        let bad = |s: String| Err(Error::InvalidArgument(s));
+        let n = mesh.nodes.len();
+        if mesh.tets.is_empty() || n < 5 {
+            return bad("a body needs at least one tetrahedron and 5 nodes".into());
+        }
+        if let Some(k) = mesh.nodes.iter().position(|p| !is_finite_vec(p)) {
+            return Err(Error::NonFinite(format!("mesh node {k}")));
+        }
+        let mut particle_volume = vec![0.0; n];
+        let mut tet_rest_volume = Vec::with_capacity(mesh.tets.len());
+        for (t, tet) in mesh.tets.iter().enumerate() {
+            if tet.iter().any(|&k| k as usize >= n) {
+                return bad(format!("tetrahedron {t} references a node out of range"));
+            }
+            let [a, b, c, d] = tet.map(|k| mesh.nodes[k as usize]);
+            let vol = tet_volume(&a, &b, &c, &d);
+            if vol <= 0.0 {
+                return bad(format!("tetrahedron {t} is not positively oriented"));
+            }
+            tet_rest_volume.push(vol);
+            for &k in tet {
+                particle_volume[k as usize] += 0.25 * vol;
+            }
+        }
+        if let Some(k) = particle_volume.iter().position(|&v| v <= 0.0) {
+            return bad(format!("node {k} belongs to no tetrahedron"));
+        }
+        options.check_radii(mesh.mean_edge_length())?;
+        let support = match options.support_radius {
+            Some(h) => SupportRadius::Fixed(h),
+            None => SupportRadius::Automatic {
+                target: options.target_neighbours as usize,
+            },
+        };
+        let mut nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
+        let boundary = mesh.boundary_triangles();
+        if options.consistent_gradients {
+            consistency::correct_gradients(&mut nbr, &mesh.nodes, &particle_volume, &boundary);
+        }
+        let density = options.material.density;
+        let (lo, hi) = mesh.bounding_box();
+        Ok(Arc::new(BodyModel {
+            options: options.clone(),
+            rest: mesh.nodes.clone(),
+            mass: particle_volume.iter().map(|v| v * density).collect(),
+            particle_volume,
+            nbr,
+            rest_volume: tet_rest_volume.iter().sum(),
+            tet_rest_volume,
+            tets: mesh.tets.clone(),
+            boundary,
+            particle_radius: options
+                .particle_radius
+                .unwrap_or_else(|| 0.5 * mesh.mean_edge_length()),
+            rest_centre: (lo + hi) * 0.5,
+            size: (hi - lo).norm(),
+        }))
+    }
+
+    /// Number of particles (= mesh nodes).
+    pub fn particle_count(&self) -> usize {
+        self.rest.len()
+    }
+    /// The options the model was built with.
+    pub fn options(&self) -> &BodyOptions {
+        &self.options
+    }
+    /// Rest positions (m), one per particle.
+    pub fn rest_positions(&self) -> &[Vec3] {
+        &self.rest
+    }
+    /// Tetrahedra (4 particle indices each).
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+    /// The neighbourhoods and their rest-state quantities.
+    pub fn neighbourhoods(&self) -> &Neighbourhoods {
+        &self.nbr
+    }
+    /// Bytes of heap memory the model's arrays hold (their lengths): what each additional
+    /// holder of a shared model does not allocate.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        let n = &self.nbr;
+        size_of_val(self.rest.as_slice())
+            + size_of_val(self.mass.as_slice())
+            + size_of_val(self.particle_volume.as_slice())
+            + size_of_val(self.tets.as_slice())
+            + size_of_val(self.tet_rest_volume.as_slice())
+            + size_of_val(self.boundary.as_slice())
+            + size_of_val(n.offsets.as_slice())
+            + size_of_val(n.index.as_slice())
+            + size_of_val(n.rest_offset.as_slice())
+            + size_of_val(n.gradient.as_slice())
+            + size_of_val(n.hourglass_weight.as_slice())
+            + size_of_val(n.support_radius.as_slice())
+            + size_of_val(n.incoming_offsets.as_slice())
+            + size_of_val(n.incoming.as_slice())
+    }
+}
