@@ -21,6 +21,7 @@
 
 pub mod fmi2;
 pub mod model;
+pub mod shared_models;
 
 pub use model::TissueSim;
 

@@ -544,7 +544,8 @@ fn build(store: &Store, resources: Option<&Path>, log: &Logger) -> Result<Sim, S
         },
         ..BodyOptions::default()
     };
-    let body = world.add_body(&organ, &options).map_err(e)?;
+    let body =
+        world.add_body_model(crate::shared_models::shared_model(&organ, &options).map_err(e)?);
     let min = Vec3::new(
         store.real(vr::FIXED_MIN_X),
         store.real(vr::FIXED_MIN_Y),
