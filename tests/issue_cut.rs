@@ -3,11 +3,9 @@
 //! in the stretched side of a sagging cantilever opens; cuts are deterministic and survive
 //! save/restore.
 
-use tissuesim::mesh::lattice_box;
-use tissuesim::{
-    Blade, BodyId, BodyOptions, Error, Material, Pose, Real, Settings, ToolOptions, ToolShape,
-    Vec3, World,
-};
+mod common;
+
+use tissuesim::{Blade, BodyId, Error, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World};
 
 /// A 12 × 3 × 3 cm bar of firm tissue (E = 100 kPa, ν = 0.45, ρ = 1060 kg/m³: it sags a few
 /// millimetres) along x, cells of 1.5 cm, its end x = −6 cm fixed.
@@ -17,18 +15,7 @@ fn bar(threads: u32) -> (World, BodyId) {
         ..Settings::default()
     };
     let mut w = World::new(settings).unwrap();
-    let mesh = lattice_box(
-        Vec3::new(-0.06, -0.015, -0.015),
-        Vec3::new(0.06, 0.015, 0.015),
-        [8, 2, 2],
-    );
-    let options = BodyOptions {
-        material: Material {
-            youngs_modulus: 1e5,
-            ..Material::default()
-        },
-        ..BodyOptions::default()
-    };
+    let (mesh, options) = common::firm_bar();
     let b = w.add_body(&mesh, &options).unwrap();
     w.fix_box(b, Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-0.0599, 1.0, 1.0))
         .unwrap();

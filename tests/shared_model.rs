@@ -3,27 +3,14 @@
 //! worlds that loaded the mesh themselves, and a cut in one world leaves the others' model
 //! untouched (copy-on-write).
 
+mod common;
+
 use std::sync::Arc;
-use tissuesim::mesh::lattice_box;
-use tissuesim::{
-    Blade, BodyId, BodyModel, BodyOptions, Material, Pose, Settings, ToolOptions, ToolShape, Vec3,
-    World,
-};
+use tissuesim::{Blade, BodyId, BodyModel, Pose, Settings, ToolOptions, ToolShape, Vec3, World};
 
 /// A 12 × 3 × 3 cm bar of firm tissue, cells of 1.5 cm.
 fn bar_model() -> Arc<BodyModel> {
-    let mesh = lattice_box(
-        Vec3::new(-0.06, -0.015, -0.015),
-        Vec3::new(0.06, 0.015, 0.015),
-        [8, 2, 2],
-    );
-    let options = BodyOptions {
-        material: Material {
-            youngs_modulus: 1e5,
-            ..Material::default()
-        },
-        ..BodyOptions::default()
-    };
+    let (mesh, options) = common::firm_bar();
     BodyModel::new(&mesh, &options).unwrap()
 }
 

@@ -52,6 +52,24 @@ pub fn liver(file: &str) -> TetMesh {
     mesh
 }
 
+/// A 12 × 3 × 3 cm bar of firm tissue along x (E = 100 kPa, the default ν and ρ), cells of
+/// 1.5 cm, centred on the origin: the cutting and shared-model scenes.
+pub fn firm_bar() -> (TetMesh, BodyOptions) {
+    let mesh = mesh::lattice_box(
+        Vec3::new(-0.06, -0.015, -0.015),
+        Vec3::new(0.06, 0.015, 0.015),
+        [8, 2, 2],
+    );
+    let options = BodyOptions {
+        material: Material {
+            youngs_modulus: 1e5,
+            ..Material::default()
+        },
+        ..BodyOptions::default()
+    };
+    (mesh, options)
+}
+
 /// The DESIGN §7 material: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.
 pub fn tissue() -> BodyOptions {
     BodyOptions {
