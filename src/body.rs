@@ -1,6 +1,6 @@
 //! A deformable body in a world: its shared load-time model ([`BodyModel`]: rest data,
 //! neighbourhoods, masses), the elastic constants and mass scaling under the world's settings,
-//! the fixed particles, the particle state, its rollback copy and the step's scratch memory.
+//! the fixed particles and the particle state.
 
 use crate::body_model::BodyModel;
 use crate::elastic::{self, ElasticModel, ForceInputs};
@@ -215,9 +215,8 @@ impl Default for BodyOptions {
     }
 }
 
-/// The dynamic state of a body's particles: what a step advances, what a diverged step's
-/// rollback restores, and what [`World::save_state`](crate::World::save_state) writes (with
-/// the tools' state and the time).
+/// The dynamic state of a body's particles: what a step advances; part of the
+/// [`WorldState`](crate::WorldState).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ParticleState {
     /// Positions (m).
@@ -239,28 +238,13 @@ impl ParticleState {
         }
     }
 
-    /// Overwrite with `other` (the same particle count) without allocating.
-    pub(crate) fn copy_from(&mut self, other: &ParticleState) {
-        self.x.copy_from_slice(&other.x);
-        self.v.copy_from_slice(&other.v);
-        self.rotation.copy_from_slice(&other.rotation);
+    /// Overwrite with `other`, reusing this value's memory (no allocation when the particle
+    /// count is the same).
+    pub(crate) fn assign(&mut self, other: &ParticleState) {
+        self.x.clone_from(&other.x);
+        self.v.clone_from(&other.v);
+        self.rotation.clone_from(&other.rotation);
     }
-}
-
-/// A body's working memory of a step, sized once and reused, so that a step allocates nothing;
-/// nothing in it outlives a substep.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct StepScratch {
-    /// Predicted positions of the current substep (m).
-    pub(crate) p: Vec<Vec3>,
-    /// Forces of the current substep (N).
-    pub(crate) force: Vec<Vec3>,
-    /// Per-pair forces of the force computation (N), one entry per neighbour pair.
-    pub(crate) pair_force: Vec<Vec3>,
-    /// Per-particle sums of their pair forces (N), for the multi-threaded force pass.
-    pub(crate) own_force: Vec<Vec3>,
-    /// XPBD multipliers of the volume constraints within a substep (one per tetrahedron).
-    pub(crate) tet_lambda: Vec<Real>,
 }
 
 /// A deformable body (see the module documentation).
@@ -275,8 +259,6 @@ pub struct Body {
     pub(crate) elastic: ElasticModel,
     /// Positions, velocities and rotations of the particles: what a step advances.
     pub(crate) state: ParticleState,
-    /// What a substep computes and throws away: predicted positions, forces, multipliers.
-    pub(crate) scratch: StepScratch,
     /// Inertial masses (kg): the physical mass plus any mass scaling.
     pub(crate) inertial_mass: Vec<Real>,
     /// Inverse inertial masses (1/kg), 0 for fixed particles.
@@ -292,8 +274,6 @@ pub struct Body {
     pub(crate) volume_constraints_on: bool,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
-    /// `state` as it was at the start of the step, restored if the step diverges.
-    pub(crate) saved: ParticleState,
 }
 
 /// Newton iterations of the rotation extraction per particle per substep before the exact SVD
@@ -308,13 +288,6 @@ impl Body {
         let mut body = Body {
             elastic: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
             state: ParticleState::at_rest(&model.rest),
-            scratch: StepScratch {
-                p: model.rest.clone(),
-                force: vec![Vec3::zeros(); n],
-                pair_force: vec![Vec3::zeros(); model.nbr.pair_count()],
-                own_force: vec![Vec3::zeros(); n],
-                tet_lambda: vec![0.0; model.tets.len()],
-            },
             inv_mass: vec![0.0; n],
             inertial_mass: model.mass.clone(),
             fixed: vec![false; n],
@@ -322,7 +295,6 @@ impl Body {
             omega_max: 0.0,
             volume_compliance: 0.0,
             volume_constraints_on: false,
-            saved: ParticleState::at_rest(&model.rest),
             model,
         };
         body.configure(settings);

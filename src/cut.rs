@@ -64,6 +64,8 @@ pub(crate) struct CutState {
     pub(crate) pair_cut: Vec<bool>,
     /// Per load-time tetrahedron: removed.
     pub(crate) tet_cut: Vec<bool>,
+    /// The same as lists, shared with the world states that hold them (rebuilt at each cut).
+    sets: Arc<CutSets>,
 }
 
 impl CutState {
@@ -74,6 +76,7 @@ impl CutState {
             stiffness: body.diagonal_stiffness(),
             pair_cut: vec![false; body.model.nbr.pair_count()],
             tet_cut: vec![false; body.model.tets.len()],
+            sets: Arc::default(),
         }
     }
 }
@@ -183,8 +186,16 @@ pub(crate) fn cut(body: &mut Body, blade: &Blade) -> CutReport {
 /// pairs (all particles with a cut pair when `changed` is `None`, else the centres of the pairs
 /// in `changed`), the tetrahedra, the rest volume, the boundary and the stability data. Returns
 /// the number of particles left without elasticity among those recomputed.
-fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> usize {
+fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -> usize {
     let n = body.state.x.len();
+    let list = |v: &[bool]| {
+        v.iter()
+            .enumerate()
+            .filter(|(_, &b)| b)
+            .map(|(k, _)| k as u32)
+            .collect()
+    };
+    state.sets = Arc::new((list(&state.pair_cut), list(&state.tet_cut)));
     let original = &state.original;
     // Copy-on-write: the first change of a shared model gives this body its own copy.
     let model = Arc::make_mut(&mut body.model);
@@ -228,8 +239,6 @@ fn apply(body: &mut Body, state: Box<CutState>, changed: Option<&[usize]>) -> us
         tets: model.tets.clone(),
     };
     model.boundary = mesh.boundary_triangles();
-    // Within the load-time capacity: no allocation.
-    body.scratch.tet_lambda.resize(body.model.tets.len(), 0.0);
     restabilise(body, &state);
     body.cuts = Some(state);
     isolated
@@ -315,25 +324,22 @@ fn recompute_row(nbr: &mut Neighbourhoods, pair_cut: &[bool], i: usize) -> bool 
 }
 
 /// The cut pairs and removed tetrahedra of `body` (load-time indices, increasing), for the
-/// saved state.
-pub(crate) fn cut_sets(body: &Body) -> CutSets {
-    let Some(c) = &body.cuts else {
-        return (Vec::new(), Vec::new());
-    };
-    let list = |v: &[bool]| {
-        v.iter()
-            .enumerate()
-            .filter(|(_, &b)| b)
-            .map(|(k, _)| k as u32)
-            .collect()
-    };
-    (list(&c.pair_cut), list(&c.tet_cut))
+/// world state: `None` when nothing is cut. Shares the body's lists (no copy).
+pub(crate) fn cut_sets(body: &Body) -> Option<Arc<CutSets>> {
+    let sets = &body.cuts.as_ref()?.sets;
+    let cut = !(sets.0.is_empty() && sets.1.is_empty());
+    cut.then(|| Arc::clone(sets))
 }
 
-/// Give `body` exactly the cut sets `pairs` and `tets` (load-time indices, checked by the
-/// caller to be in range): uncut when both are empty.
-pub(crate) fn restore(body: &mut Body, pairs: &[u32], tets: &[u32]) {
-    if cut_sets(body) == (pairs.to_vec(), tets.to_vec()) {
+/// Give `body` exactly the cut sets `sets` (load-time indices, checked by the caller to be in
+/// range; `None`: uncut). Nothing is rebuilt when they are the body's already.
+pub(crate) fn restore(body: &mut Body, sets: &Option<Arc<CutSets>>) {
+    let now = cut_sets(body);
+    let same = match (&now, sets) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b) || a == b,
+        (a, b) => a.is_none() && b.is_none(),
+    };
+    if same {
         return;
     }
     let mut state = body
@@ -342,10 +348,14 @@ pub(crate) fn restore(body: &mut Body, pairs: &[u32], tets: &[u32]) {
         .unwrap_or_else(|| Box::new(CutState::new(body)));
     state.pair_cut.iter_mut().for_each(|c| *c = false);
     state.tet_cut.iter_mut().for_each(|c| *c = false);
-    pairs
-        .iter()
-        .for_each(|&e| state.pair_cut[e as usize] = true);
-    tets.iter().for_each(|&t| state.tet_cut[t as usize] = true);
+    if let Some(sets) = sets {
+        sets.0
+            .iter()
+            .for_each(|&e| state.pair_cut[e as usize] = true);
+        sets.1
+            .iter()
+            .for_each(|&t| state.tet_cut[t as usize] = true);
+    }
     apply(body, state, None);
 }
 
@@ -361,7 +371,6 @@ pub(crate) fn load_time_counts(body: &Body) -> (usize, usize) {
 impl Body {
     /// Neighbour pairs cut and tetrahedra removed so far (0, 0 for a body never cut).
     pub fn cut_counts(&self) -> (usize, usize) {
-        let (pairs, tets) = cut_sets(self);
-        (pairs.len(), tets.len())
+        cut_sets(self).map_or((0, 0), |s| (s.0.len(), s.1.len()))
     }
 }

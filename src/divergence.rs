@@ -3,7 +3,7 @@
 //! rolled back. O(particles + tetrahedra) per body.
 //!
 //! The extent and volume bounds fail a step only when it moves the body farther out of them
-//! than it was at the start of the step (`Body::saved`): a body set into an inverted or
+//! than it was at the start of the step (`before`, its positions then): a body set into an inverted or
 //! flattened state on purpose recovers through states outside the volume range, and each of
 //! those steps brings it closer.
 
@@ -11,8 +11,9 @@ use crate::body::{volume_of, Body};
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::settings::DivergenceLimits;
 
-/// Why `body` has diverged, or `None` when it is within `limits`.
-pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String> {
+/// Why `body` has diverged, or `None` when it is within `limits`; `before` holds its positions
+/// (m) at the start of the step.
+pub(crate) fn diverged(body: &Body, before: &[Vec3], limits: &DivergenceLimits) -> Option<String> {
     let size = body.model.size;
     let max_speed = limits.max_speed * size;
     let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
@@ -32,7 +33,7 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
         hi = hi.sup(x);
     }
     let extent = (hi - lo).norm() / size;
-    if extent > limits.max_extent_ratio && extent > extent_of(&body.saved.x) / size {
+    if extent > limits.max_extent_ratio && extent > extent_of(before) / size {
         return Some(format!(
             "the body spans {extent:.3e} times its rest size (limit {})",
             limits.max_extent_ratio
@@ -40,8 +41,10 @@ pub(crate) fn diverged(body: &Body, limits: &DivergenceLimits) -> Option<String>
     }
     let (min_ratio, max_ratio) = limits.volume_ratio;
     let ratio = body.volume_ratio();
-    let before = || volume_of(&body.saved.x, &body.model.tets) / body.model.rest_volume;
-    if (ratio < min_ratio && ratio < before()) || (ratio > max_ratio && ratio > before()) {
+    let ratio_before = || volume_of(before, &body.model.tets) / body.model.rest_volume;
+    if (ratio < min_ratio && ratio < ratio_before())
+        || (ratio > max_ratio && ratio > ratio_before())
+    {
         return Some(format!(
             "its volume is {ratio:.3e} times the rest volume (accepted [{min_ratio}, {max_ratio}])"
         ));

@@ -17,6 +17,7 @@ use crate::body::Body;
 use crate::collision::tool::{Pose, Tool};
 use crate::error::{check_finite, Error};
 use crate::math::{Real, Vec3};
+use crate::solver::StepScratch;
 use parry3d_f64::math::Point;
 
 /// How a tool grasps.
@@ -166,22 +167,30 @@ impl Grasp {
     /// One projection pass of every attachment towards the tool at pose `cur` for a substep `h`
     /// (s); the particles' corrections (times their masses) go into `tool`'s wrench
     /// accumulators and this grasp's own.
-    pub(crate) fn project(&mut self, tool: &mut Tool, bodies: &mut [Body], cur: &Pose, h: Real) {
+    pub(crate) fn project(
+        &mut self,
+        tool: &mut Tool,
+        bodies: &[Body],
+        scratch: &mut [StepScratch],
+        cur: &Pose,
+        h: Real,
+    ) {
         let iso = cur.isometry();
         for a in &mut self.attachments {
-            let body = &mut bodies[a.body as usize];
+            let b = a.body as usize;
+            let body = &bodies[b];
             let i = a.particle as usize;
             let w = body.inv_mass[i];
             if w == 0.0 {
                 continue;
             }
             let target = iso.transform_point(&Point::from(a.anchor)).coords;
-            let c = body.scratch.p[i] - target;
+            let c = scratch[b].p[i] - target;
             let alpha = a.compliance / (h * h);
             let dl = -(c + a.lambda * alpha) / (w + alpha);
             a.lambda += dl;
             let dp = dl * w;
-            body.scratch.p[i] += dp;
+            scratch[b].p[i] += dp;
             let impulse = dp * body.inertial_mass[i];
             tool.acc_impulse += impulse;
             tool.acc_moment += (target - cur.position).cross(&impulse);

@@ -47,6 +47,7 @@ pub(crate) mod stability;
 pub mod state;
 pub mod statics;
 pub(crate) mod world;
+pub(crate) mod world_state;
 
 pub use body::{
     Body, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
@@ -66,3 +67,4 @@ pub use needle::{NeedleOptions, NeedleState};
 pub use neighbours::MAX_NEIGHBOURS;
 pub use settings::{ContactMode, DivergenceLimits, Settings};
 pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World};
+pub use world_state::WorldState;

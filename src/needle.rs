@@ -26,6 +26,7 @@ use crate::body::Body;
 use crate::collision::tool::{Pose, Tool, ToolShape};
 use crate::error::{check_finite, Error};
 use crate::math::{Real, Vec3};
+use crate::solver::StepScratch;
 use parry3d_f64::math::Point;
 
 /// How a needle punctures and holds the tissue.
@@ -253,9 +254,17 @@ impl Needle {
     /// One projection pass of the held particles towards the shaft at pose `cur` for a substep
     /// `h` (s): lateral XPBD constraints and axial stick-or-slip friction; the corrections
     /// (times the particles' masses) go into `tool`'s wrench accumulators.
-    pub(crate) fn project(&mut self, tool: &mut Tool, bodies: &mut [Body], cur: &Pose, h: Real) {
+    pub(crate) fn project(
+        &mut self,
+        tool: &mut Tool,
+        bodies: &[Body],
+        scratch: &mut [StepScratch],
+        cur: &Pose,
+        h: Real,
+    ) {
         let Some(b) = self.body else { return };
-        let body = &mut bodies[b as usize];
+        let b = b as usize;
+        let body = &bodies[b];
         if self.holds.is_empty() {
             return;
         }
@@ -273,7 +282,7 @@ impl Needle {
             if w == 0.0 {
                 continue;
             }
-            let before = body.scratch.p[i];
+            let before = scratch[b].p[i];
             let local = iso.inverse_transform_point(&Point::from(before)).coords;
             // Lateral: towards the anchor's offset from the axis (local x, z).
             let c = Vec3::new(local.x - hold.anchor.x, 0.0, local.z - hold.anchor.z);
@@ -289,7 +298,7 @@ impl Needle {
                 hold.anchor.y = local.y + axial;
             }
             let dp = lateral_world + axis * axial;
-            body.scratch.p[i] += dp;
+            scratch[b].p[i] += dp;
             let impulse = dp * m;
             tool.acc_impulse += impulse;
             let at = iso.transform_point(&Point::from(hold.anchor)).coords;

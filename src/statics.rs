@@ -467,7 +467,6 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error
         x.copy_from_slice(&body.state.x);
     }
     body.state.x.copy_from_slice(&x);
-    body.scratch.p.copy_from_slice(&x);
     body.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
     for i in 0..x.len() {
         let f = crate::elastic::deformation_gradient(&body.model.nbr, &x, i);

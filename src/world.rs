@@ -3,7 +3,6 @@
 
 use crate::body::{Body, BodyOptions};
 use crate::body_model::BodyModel;
-use crate::collision::hash_grid::HashGrid;
 use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::error::Error;
@@ -61,9 +60,8 @@ pub struct World {
     pub(crate) blades: Vec<bool>,
     pub(crate) render_surfaces: Vec<RenderSurface>,
     pub(crate) pair_friction: Vec<PairFriction>,
-    pub(crate) grid: HashGrid,
-    /// Scratch memory of the tool–surface contact pass.
-    pub(crate) surface_scratch: crate::solver::SurfaceScratch,
+    /// All the memory a step uses and throws away.
+    pub(crate) workspace: crate::solver::Workspace,
     pub(crate) pool: Pool,
     pub(crate) time: Real,
     pub(crate) diverged_steps: u64,
@@ -83,8 +81,7 @@ impl World {
             blades: Vec::new(),
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
-            grid: HashGrid::default(),
-            surface_scratch: Default::default(),
+            workspace: Default::default(),
             time: 0.0,
             diverged_steps: 0,
         })
@@ -135,9 +132,8 @@ impl World {
     /// and its arrays are not copied. Cutting the body gives it its own copy of the model
     /// first; the other holders keep theirs.
     pub fn add_body_model(&mut self, model: Arc<BodyModel>) -> BodyId {
+        self.workspace.add_body(&model);
         self.bodies.push(Body::from_model(model, &self.settings));
-        self.grid
-            .reserve(self.bodies.iter().map(|b| b.particle_count()).sum());
         BodyId(self.bodies.len() as u32 - 1)
     }
     /// Number of bodies.

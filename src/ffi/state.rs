@@ -32,7 +32,8 @@ pub unsafe extern "C" fn ts_world_state_size(
     })
 }
 
-/// Save the world's dynamic state (time, particle positions and velocities, tool poses, ...)
+/// Save the world's dynamic state (time, particle positions and velocities, fixed flags, cuts,
+/// tool poses, grasps, needle holds)
 /// into `buf` of `len` bytes. `len` below ts_world_state_size gives TS_STATUS_BUFFER_TOO_SMALL
 /// and writes nothing. The number of bytes written goes to *out_written, which is optional
 /// (may be NULL). Restoring it with ts_world_restore_state and stepping again reproduces the

@@ -4,8 +4,9 @@
 //! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
 //! limit of the stiffest body, at least `Settings::min_substeps`). Data flow of one step:
 //!
-//! 1. copy each body's particle state (`x`, `v`, rotations: one `ParticleState` value) into
-//!    its rollback copy `saved`; clear the tools' wrench accumulators;
+//! 1. copy the world's state (one [`WorldState`](crate::WorldState) value: particles, fixed
+//!    flags, cuts, tools, grasps, needle holds, time) into the workspace's rollback copy; clear
+//!    the tools' wrench accumulators;
 //! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
@@ -14,23 +15,27 @@
 //!    tool samples against the particles; off between a needle and the body it punctured and
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
-//! 3. the divergence check (`crate::divergence`): a failure swaps the rollback copy back in;
+//! 3. the divergence check (`crate::divergence`): a failure puts the rollback copy back
+//!    (`World::apply_state`, the code `World::set_state` uses after its checks);
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
 //!    poses, needle puncture or withdrawal, time.
 //!
 //! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation). The bodies own their state (`state`:
-//! positions, velocities, rotations, and its rollback copy `saved`) and their
-//! `scratch` (predicted positions `p`, forces, multipliers); the world owns the hash grid and
-//! the thread pool.
+//! substeps (linear position, slerp orientation). The passes read the bodies (model and state)
+//! and write the [`Workspace`] (per body a `StepScratch`: predicted positions `p`, forces,
+//! multipliers; the hash grid; the surface-contact scratch; the rollback copy); only the
+//! prediction (velocities, rotations) and the final update (`v = (p − x)/h`, `x = p`) write the
+//! bodies' state.
 
 mod organ_contact;
 mod predict;
 mod sampled_contact;
 mod surface_contact;
 mod volume;
+mod workspace;
 
 pub(crate) use surface_contact::{SurfaceScratch, SURFACE_SKIN};
+pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
@@ -47,9 +52,8 @@ impl World {
     /// step and [`Error::Diverged`] says which body and why.
     pub fn step(&mut self) -> Result<StepReport, Error> {
         let (n, clamped) = self.substeps_needed();
-        for b in &mut self.bodies {
-            b.saved.copy_from(&b.state);
-        }
+        let mut rollback = std::mem::take(&mut self.workspace.rollback);
+        self.state_into(&mut rollback);
         let h = self.settings.dt / n as Real;
         for t in self.tools.iter_mut().flatten() {
             t.acc_impulse = Vec3::zeros();
@@ -60,16 +64,15 @@ impl World {
             self.substep(h, k, n);
         }
         let limits = self.settings.divergence;
-        let failure =
-            self.bodies.iter().enumerate().find_map(|(b, body)| {
-                crate::divergence::diverged(body, &limits).map(|why| (b, why))
+        let failure = (self.bodies.iter().zip(&rollback.bodies))
+            .enumerate()
+            .find_map(|(b, (body, before))| {
+                crate::divergence::diverged(body, &before.particles.x, &limits).map(|why| (b, why))
             });
         if let Some((b, why)) = failure {
-            for body in &mut self.bodies {
-                // The state at the start of the step back as one value; `saved` is rewritten
-                // at the start of the next step.
-                std::mem::swap(&mut body.state, &mut body.saved);
-            }
+            // The whole state at the start of the step back: particles, grasps, needle holds.
+            self.apply_state(&rollback);
+            self.workspace.rollback = rollback;
             self.diverged_steps += 1;
             return Err(Error::Diverged(format!(
                 "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
@@ -121,6 +124,7 @@ impl World {
             }
         }
         self.time += dt;
+        self.workspace.rollback = rollback;
         Ok(StepReport {
             substeps: n,
             substeps_clamped: clamped,
@@ -133,8 +137,9 @@ impl World {
         let s = &self.settings;
         let gravity = s.gravity;
         let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
-        for body in &mut self.bodies {
-            predict::predict(body, gravity, h, alpha_damp, &self.pool);
+        let scratch = &mut self.workspace.bodies;
+        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter_mut()) {
+            predict::predict(body, scratch, gravity, h, alpha_damp, &self.pool);
         }
         let organ_contact = self.bodies.len() > 1 || s.self_contact;
         if organ_contact {
@@ -144,8 +149,9 @@ impl World {
                     .iter()
                     .map(|b| b.model.particle_radius)
                     .fold(0.0, Real::max);
-            self.grid
-                .build(self.bodies.iter().map(|b| b.scratch.p.as_slice()), cell);
+            self.workspace
+                .grid
+                .build(scratch.iter().map(|s| s.p.as_slice()), cell);
         }
         for t in self.tools.iter_mut().flatten() {
             t.acc_contacts = 0;
@@ -161,14 +167,15 @@ impl World {
         let s_prev = (k - 1) as Real / n as Real;
         for it in 0..self.settings.iterations {
             if self.settings.volume_constraints {
-                for body in &mut self.bodies {
-                    volume::project_volumes(body, h);
+                for (body, scratch) in self.bodies.iter().zip(scratch.iter_mut()) {
+                    volume::project_volumes(body, scratch, h);
                 }
             }
             if organ_contact {
                 organ_contact::project_organ_contacts(
-                    &self.grid,
-                    &mut self.bodies,
+                    &self.workspace.grid,
+                    &self.bodies,
+                    scratch,
                     &self.pair_friction,
                     self.settings.self_contact,
                 );
@@ -188,16 +195,17 @@ impl World {
                 }
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                for (b, body) in self.bodies.iter_mut().enumerate() {
+                for (b, (body, scratch)) in self.bodies.iter().zip(scratch.iter_mut()).enumerate() {
                     if needle.as_ref().is_some_and(|n| n.passes_through(b)) || grasp.holds(b) {
                         continue;
                     }
                     let motion = (&prev, &cur);
                     match mode {
                         ContactMode::ExactShape => surface_contact::project_tool_surface(
-                            &mut self.surface_scratch,
+                            &mut self.workspace.surface,
                             tool,
                             body,
+                            scratch,
                             motion,
                             (max_correction, h),
                             it == 0,
@@ -205,6 +213,7 @@ impl World {
                         ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
                             tool,
                             body,
+                            scratch,
                             motion,
                             max_correction,
                             it == 0,
@@ -216,22 +225,22 @@ impl World {
                 if let Some(tool) = tool {
                     if !grasp.attachments.is_empty() {
                         let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                        grasp.project(tool, &mut self.bodies, &cur, h);
+                        grasp.project(tool, &self.bodies, scratch, &cur, h);
                     }
                 }
             }
             for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
                 if let (Some(tool), Some(needle)) = (tool, needle) {
                     let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                    needle.project(tool, &mut self.bodies, &cur, h);
+                    needle.project(tool, &self.bodies, scratch, &cur, h);
                 }
             }
         }
-        for body in &mut self.bodies {
-            let inv_h = 1.0 / h;
+        let inv_h = 1.0 / h;
+        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter()) {
             for i in 0..body.state.x.len() {
-                body.state.v[i] = (body.scratch.p[i] - body.state.x[i]) * inv_h;
-                body.state.x[i] = body.scratch.p[i];
+                body.state.v[i] = (scratch.p[i] - body.state.x[i]) * inv_h;
+                body.state.x[i] = scratch.p[i];
             }
         }
     }

@@ -5,21 +5,23 @@ use crate::body::Body;
 use crate::collision::hash_grid::HashGrid;
 use crate::constraints::contact::project_particle_particle;
 use crate::constraints::friction::friction_correction;
+use crate::solver::StepScratch;
 use crate::world::PairFriction;
 
 /// One Gauss–Seidel pass over the particle–particle contacts between bodies (and within a body
-/// when `self_contact`), found through `grid` (built on the predicted positions), with the
+/// when `self_contact`), found through `grid` (built on the predicted positions, in `scratch`), with the
 /// body-pair friction of `pair_friction`.
 pub(crate) fn project_organ_contacts(
     grid: &HashGrid,
-    bodies: &mut [Body],
+    bodies: &[Body],
+    scratch: &mut [StepScratch],
     pair_friction: &[PairFriction],
     self_contact: bool,
 ) {
     let nb = bodies.len();
     for a in 0..nb {
         for i in 0..bodies[a].particle_count() {
-            let pi = bodies[a].scratch.p[i];
+            let pi = scratch[a].p[i];
             let friction = pair_friction;
             grid.for_each_near(&pi, |[b, j]| {
                 let (b, j) = (b as usize, j as usize);
@@ -36,7 +38,7 @@ pub(crate) fn project_organ_contacts(
                     }
                 }
                 let (wa, wb) = (bodies[a].inv_mass[i], bodies[b].inv_mass[j]);
-                let (mut pa, mut pb) = (bodies[a].scratch.p[i], bodies[b].scratch.p[j]);
+                let (mut pa, mut pb) = (scratch[a].p[i], scratch[b].p[j]);
                 let Some(c) = project_particle_particle(&mut pa, &mut pb, wa, wb, ra + rb) else {
                     return;
                 };
@@ -48,8 +50,8 @@ pub(crate) fn project_organ_contacts(
                     pa += dfr * (wa / wsum);
                     pb -= dfr * (wb / wsum);
                 }
-                bodies[a].scratch.p[i] = pa;
-                bodies[b].scratch.p[j] = pb;
+                scratch[a].p[i] = pa;
+                scratch[b].p[j] = pb;
             });
         }
     }

@@ -8,6 +8,7 @@ use crate::collision::tool::{Pose, Tool};
 use crate::constraints::contact::{project_point_sphere, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
+use crate::solver::StepScratch;
 use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
@@ -15,7 +16,8 @@ use parry3d_f64::math::Point;
 /// correction at most `max_correction` (m), and accumulate the tool's impulse and moment.
 pub(crate) fn project_sampled_contacts(
     tool: &mut Tool,
-    body: &mut Body,
+    body: &Body,
+    scratch: &mut StepScratch,
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
     count: bool,
@@ -31,7 +33,7 @@ pub(crate) fn project_sampled_contacts(
         if body.inv_mass[i] == 0.0 {
             continue;
         }
-        let before = body.scratch.p[i];
+        let before = scratch.p[i];
         if (before - centre).norm_squared() > reach * reach {
             continue;
         }
@@ -60,7 +62,7 @@ pub(crate) fn project_sampled_contacts(
             if count {
                 tool.acc_contacts += 1;
             }
-            body.scratch.p[i] = p;
+            scratch.p[i] = p;
         }
     }
 }

@@ -31,6 +31,7 @@ use crate::body::Body;
 use crate::collision::tool::{Pose, Tool, ToolShape};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
+use crate::solver::StepScratch;
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CSOPoint, GJKResult, VoronoiSimplex};
@@ -118,15 +119,16 @@ impl std::fmt::Debug for SurfaceScratch {
 }
 
 /// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this substep)
-/// and the boundary triangles of `body`, each correction at most `max_correction` (m) beyond the
+/// and the boundary triangles of `body` (moving its predicted positions in `predicted`), each correction at most `max_correction` (m) beyond the
 /// contact point's predicted motion towards the tool in the substep of `h` (s), in up to
 /// [`MAX_SURFACE_PASSES`] passes (until the largest correction of a pass is below
 /// [`SURFACE_PASS_TOLERANCE`] skins), and accumulate the tool's impulse and moment; `count` adds
 /// the triangles in contact in the first pass to the tool's contact count.
 pub(crate) fn project_tool_surface(
-    scratch: &mut SurfaceScratch,
+    surface: &mut SurfaceScratch,
     tool: &mut Tool,
-    body: &mut Body,
+    body: &Body,
+    predicted: &mut StepScratch,
     (prev, cur): (&Pose, &Pose),
     (max_correction, h): (Real, Real),
     count: bool,
@@ -148,7 +150,7 @@ pub(crate) fn project_tool_surface(
         epa,
         near,
         residual,
-    } = scratch;
+    } = surface;
     near.clear();
     residual.clear();
     if near.capacity() < body.model.boundary.len() {
@@ -161,7 +163,7 @@ pub(crate) fn project_tool_surface(
         if corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
             continue;
         }
-        let [a, b, c] = corners.map(|k| body.scratch.p[k]);
+        let [a, b, c] = corners.map(|k| predicted.p[k]);
         let centroid = (a + b + c) / 3.0;
         let extent = [a, b, c]
             .iter()
@@ -179,7 +181,7 @@ pub(crate) fn project_tool_surface(
         for (&t, left) in near.iter().zip(residual.iter_mut()) {
             let corners = body.model.boundary[t as usize].map(|k| k as usize);
             let w = corners.map(|k| body.inv_mass[k]);
-            let [a, b, c] = corners.map(|k| body.scratch.p[k]);
+            let [a, b, c] = corners.map(|k| predicted.p[k]);
             let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
                 continue;
             };
@@ -209,7 +211,7 @@ pub(crate) fn project_tool_surface(
                 continue;
             }
             let moved: Vec3 = (0..3)
-                .map(|k| (body.scratch.p[corners[k]] - body.state.x[corners[k]]) * weights[k])
+                .map(|k| (predicted.p[corners[k]] - body.state.x[corners[k]]) * weights[k])
                 .sum();
             // The cap applies to penetration older than this substep: what the contact point's
             // predicted motion towards the tool (v h) brought in is removed whole. What the cap
@@ -217,8 +219,8 @@ pub(crate) fn project_tool_surface(
             // what the neighbouring triangles' corrections pushed in beyond it, each under the
             // same cap.
             let depth = contact.depth;
-            let predicted: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
-            let cap = max_correction + (-predicted.dot(&contact.direction)).max(0.0) * h;
+            let approach: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
+            let cap = max_correction + (-approach.dot(&contact.direction)).max(0.0) * h;
             let applied = if pass == 0 {
                 let applied = depth.min(cap);
                 *left = depth - applied;
@@ -243,7 +245,7 @@ pub(crate) fn project_tool_surface(
             let mut impulse = Vec3::zeros();
             for k in 0..3 {
                 let dp = shift * shares[k];
-                body.scratch.p[corners[k]] += dp;
+                predicted.p[corners[k]] += dp;
                 impulse += dp * body.inertial_mass[corners[k]];
             }
             tool.acc_impulse += impulse;
