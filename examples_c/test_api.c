@@ -418,6 +418,42 @@ static void test_cut(double h) {
     ts_world_free(world);
 }
 
+/* A body shared into a second world: the same particles, the same motion, and it outlives the
+ * world it came from (the model is reference-counted). */
+static void test_shared(double h) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *a = NULL, *b = NULL;
+    uint32_t body = 99, copy = 99;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &a));
+    CHECK_OK(ts_world_new(&settings, &b));
+    CHECK_OK(ts_world_add_body_from_arrays(a, nodes, NN, tets, NT, &material, NULL, &body));
+    CHECK_OK(ts_world_add_body_shared(b, a, body, &copy));
+    CHECK(copy == 0);
+    CHECK_ST(ts_world_add_body_shared(b, a, 5, &copy), TS_STATUS_UNKNOWN_BODY);
+    CHECK_ST(ts_world_add_body_shared(b, NULL, body, &copy), TS_STATUS_NULL_PARAMETER);
+    double lo[3] = {OX - 1, -1e-9, -1}, hi[3] = {OX + 1, 1e-9, 1};
+    size_t fixed_a = 0, fixed_b = 0;
+    CHECK_OK(ts_body_fix_box(a, body, lo, hi, &fixed_a));
+    CHECK_OK(ts_body_fix_box(b, copy, lo, hi, &fixed_b));
+    CHECK(fixed_a == fixed_b && fixed_a > 0);
+    static double xa[3 * NN], xb[3 * NN];
+    for (int k = 0; k < 10; k++) {
+        CHECK_OK(ts_world_step(a, NULL));
+        CHECK_OK(ts_world_step(b, NULL));
+    }
+    CHECK_OK(ts_body_positions(a, body, xa, 3 * NN));
+    CHECK_OK(ts_body_positions(b, copy, xb, 3 * NN));
+    CHECK(memcmp(xa, xb, sizeof xa) == 0);
+    ts_world_free(a);
+    CHECK_OK(ts_world_step(b, NULL));
+    CHECK_OK(ts_body_positions(b, copy, xb, 3 * NN));
+    CHECK(xb[3 * (NN - 1) + 1] < h * CELLS);
+    ts_world_free(b);
+}
+
 int main(void) {
     long steps = getenv("TS_STEPS") ? atol(getenv("TS_STEPS")) : 20;
     if (steps < 2) steps = 2;
@@ -428,6 +464,7 @@ int main(void) {
     test_grasp(h);
     test_needle(h);
     test_cut(h);
+    test_shared(h);
 
     /* ---- version, status strings, last error ---- */
     CHECK(ts_version() == TISSUESIM_VERSION);

@@ -666,6 +666,25 @@ enum ts_status ts_world_add_default_organ(struct ts_world *world,
                                           uint32_t *out_body);
 
 /**
+ * Add to `world` a body on the load-time model of body `body` of `source` (another world or
+ * the same one), at rest, nothing fixed: the same mesh, options and material without redoing
+ * the load-time work (neighbour search, consistent gradients) and without copying its arrays,
+ * which the two bodies share read-only (a body that is cut later takes its own copy). For a
+ * body already cut, the new body is the uncut original. Source indices are the source
+ * body's. The new body's id goes to *out_body.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle not used by another thread; `source` is NULL or a live
+ * handle that no other thread changes during the call (it may be `world`); `out_body` is
+ * NULL or writable.
+ */
+enum ts_status ts_world_add_body_shared(struct ts_world *world,
+                                        const struct ts_world *source,
+                                        uint32_t body,
+                                        uint32_t *out_body);
+
+/**
  * Fix the particles whose indices (count of them, 0-based particle indices) are given: they
  * keep their current positions. An index >= the particle count gives
  * TS_STATUS_INVALID_ARGUMENT and fixes nothing.

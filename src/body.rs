@@ -367,9 +367,9 @@ impl Body {
     pub fn boundary_triangles(&self) -> &[[u32; 3]] {
         &self.model.boundary
     }
-    /// The load-time model this body runs on: pass it to
-    /// [`World::add_body_model`](crate::World::add_body_model) to build the same body elsewhere
-    /// without redoing the load-time work.
+    /// The model this body runs on now: the load-time model, shared with its other holders,
+    /// until a cut gives the body its own cut copy. To build the same body elsewhere use
+    /// [`Body::load_time_model`].
     pub fn model(&self) -> &Arc<BodyModel> {
         &self.model
     }

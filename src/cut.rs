@@ -369,6 +369,12 @@ pub(crate) fn load_time_counts(body: &Body) -> (usize, usize) {
 }
 
 impl Body {
+    /// The model this body was built on (for a cut body, the uncut original it keeps to rebuild
+    /// from): pass it to [`World::add_body_model`](crate::World::add_body_model) to build the
+    /// same body elsewhere without redoing the load-time work.
+    pub fn load_time_model(&self) -> &Arc<BodyModel> {
+        self.cuts.as_ref().map_or(&self.model, |c| &c.original)
+    }
     /// Neighbour pairs cut and tetrahedra removed so far (0, 0 for a body never cut).
     pub fn cut_counts(&self) -> (usize, usize) {
         cut_sets(self).map_or((0, 0), |s| (s.0.len(), s.1.len()))

@@ -733,3 +733,50 @@ fn c_and_rust_share_one_validation() {
     let st = unsafe { ts_world_add_tool_sphere(w.0, 0.01, &zero, null(), &mut t) };
     assert_eq!((st, last_error()), (status_of(&rust), rust.to_string()));
 }
+
+/// `ts_world_add_body_shared` puts the same body into another world (or the same one) without
+/// a mesh: same particles, same source indices, and bit-identical motion; bad handles and ids
+/// are refused with their status.
+#[test]
+fn a_body_shared_from_another_world_moves_alike() {
+    let a = hanging_cube();
+    let b = W::new(&settings());
+    let mut id = u32::MAX;
+    ok(unsafe { ts_world_add_body_shared(b.0, a.0, 0, &mut id) });
+    assert_eq!(id, 0);
+    assert_eq!(b.particles(0), a.particles(0));
+    let source = |w: &W| {
+        let mut v = vec![u32::MAX; w.particles(0)];
+        ok(unsafe { ts_body_source_indices(w.0, 0, v.as_mut_ptr(), v.len()) });
+        v
+    };
+    assert_eq!(source(&b), source(&a));
+    // The shared body is at rest and unfixed: fix the same face, then both hang alike.
+    assert_eq!(b.fix_box(0, [-1.0, SIZE / 2.0 - 1e-6, -1.0], [1.0; 3]), 16);
+    let rest = a.positions(0);
+    a.step(30);
+    b.step(30);
+    assert_ne!(a.positions(0), rest, "the cube hangs");
+    assert_eq!(a.positions(0), b.positions(0));
+    // Into the same world: a second body on the same model.
+    ok(unsafe { ts_world_add_body_shared(a.0, a.0, 0, &mut id) });
+    assert_eq!((id, a.particles(1)), (1, a.particles(0)));
+    expect(
+        unsafe { ts_world_add_body_shared(b.0, a.0, 7, &mut id) },
+        S::UnknownBody,
+        "body id 7",
+    );
+    expect(
+        unsafe { ts_world_add_body_shared(b.0, null(), 0, &mut id) },
+        S::NullParameter,
+        "world",
+    );
+    expect(
+        unsafe { ts_world_add_body_shared(b.0, a.0, 0, null_mut()) },
+        S::NullParameter,
+        "out_body",
+    );
+    let mut count = 0;
+    ok(unsafe { ts_world_body_count(b.0, &mut count) });
+    assert_eq!(count, 1, "a refused call added nothing");
+}

@@ -2,6 +2,7 @@
 //! their state into caller buffers.
 
 use crate::body::{Body, BodyOptions, Material};
+use crate::body_model::BodyModel;
 use crate::ffi::args::{
     all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,
 };
@@ -15,6 +16,7 @@ use crate::world::BodyId;
 use std::ffi::{c_char, CStr};
 use std::mem::MaybeUninit;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// An isotropic linear-elastic material (SI units). ts_material_default gives liver-like tissue.
 #[repr(C)]
@@ -134,7 +136,13 @@ impl ts_world {
         source: Vec<u32>,
         options: &BodyOptions,
     ) -> FfiResult<u32> {
-        let id = self.mutate(|w| w.add_body(mesh, options))?.0;
+        let model = BodyModel::new(mesh, options)?;
+        self.add_model(model, source)
+    }
+
+    /// Add a body on `model` and remember where its particles came from.
+    fn add_model(&mut self, model: Arc<BodyModel>, source: Vec<u32>) -> FfiResult<u32> {
+        let id = self.mutate(|w| Ok(w.add_body_model(model)))?.0;
         let slot = id as usize;
         if self.source_indices.len() <= slot {
             self.source_indices.resize(slot + 1, Vec::new());
@@ -290,6 +298,43 @@ pub unsafe extern "C" fn ts_world_add_default_organ(
         let mesh = mesh::default_organ();
         let source = (0..mesh.nodes.len() as u32).collect();
         let id = h.add_mesh(&mesh, source, &o)?;
+        // SAFETY: checked non-NULL.
+        unsafe { write(out_body, id) };
+        Ok(())
+    })
+}
+
+/// Add to `world` a body on the load-time model of body `body` of `source` (another world or
+/// the same one), at rest, nothing fixed: the same mesh, options and material without redoing
+/// the load-time work (neighbour search, consistent gradients) and without copying its arrays,
+/// which the two bodies share read-only (a body that is cut later takes its own copy). For a
+/// body already cut, the new body is the uncut original. Source indices are the source
+/// body's. The new body's id goes to *out_body.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle not used by another thread; `source` is NULL or a live
+/// handle that no other thread changes during the call (it may be `world`); `out_body` is
+/// NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_add_body_shared(
+    world: *mut ts_world,
+    source: *const ts_world,
+    body: u32,
+    out_body: *mut u32,
+) -> ts_status {
+    guard(|| {
+        non_null(out_body, "out_body")?;
+        let (model, indices) = {
+            // SAFETY: contract of this function; the reference ends before `world` is borrowed
+            // mutably (the two may be the same handle).
+            let src = unsafe { world_ref(source)? };
+            let b = src.body(body)?;
+            let indices = src.source_indices.get(body as usize).cloned();
+            (Arc::clone(b.load_time_model()), indices.unwrap_or_default())
+        };
+        // SAFETY: contract of this function.
+        let id = unsafe { world_mut(world)? }.add_model(model, indices)?;
         // SAFETY: checked non-NULL.
         unsafe { write(out_body, id) };
         Ok(())
