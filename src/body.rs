@@ -383,9 +383,11 @@ impl Body {
     pub fn contains(&self, point: &Vec3) -> bool {
         crate::collision::winding::inside_surface(point, &self.state.x, &self.model.boundary)
     }
-    /// Current volume (m³): the sum of the signed tetrahedron volumes.
+    /// Current volume (m³): the sum of the signed tetrahedron volumes, computed as the volume
+    /// the boundary surface encloses (the same sum: the inner faces cancel), a pass over the
+    /// boundary triangles instead of the tetrahedra.
     pub fn volume(&self) -> Real {
-        volume_of(&self.state.x, &self.model.tets)
+        volume_of(&self.state.x, &self.model.boundary)
     }
     /// Rest volume (m³).
     pub fn rest_volume(&self) -> Real {
@@ -559,12 +561,19 @@ impl Body {
     }
 }
 
-/// Sum of the signed volumes (m³) of `tets` at positions `x`.
-pub(crate) fn volume_of(x: &[Vec3], tets: &[[u32; 4]]) -> Real {
-    tets.iter()
+/// Volume (m³) enclosed by the closed `boundary` (outward triangles) at positions `x`: the sum
+/// of the signed volumes of the tetrahedra it bounds.
+pub(crate) fn volume_of(x: &[Vec3], boundary: &[[u32; 3]]) -> Real {
+    let Some(&[o, ..]) = boundary.first() else {
+        return 0.0;
+    };
+    // The divergence theorem about a point of the surface (small terms, little cancellation).
+    let o = x[o as usize];
+    boundary
+        .iter()
         .map(|t| {
-            let [a, b, c, d] = t.map(|k| k as usize);
-            tet_volume(&x[a], &x[b], &x[c], &x[d])
+            let [a, b, c] = t.map(|k| x[k as usize]);
+            tet_volume(&o, &a, &b, &c)
         })
         .sum()
 }

@@ -41,7 +41,7 @@ pub(crate) fn diverged(body: &Body, before: &[Vec3], limits: &DivergenceLimits) 
     }
     let (min_ratio, max_ratio) = limits.volume_ratio;
     let ratio = body.volume_ratio();
-    let ratio_before = || volume_of(before, &body.model.tets) / body.model.rest_volume;
+    let ratio_before = || volume_of(before, &body.model.boundary) / body.model.rest_volume;
     if (ratio < min_ratio && ratio < ratio_before())
         || (ratio > max_ratio && ratio > ratio_before())
     {

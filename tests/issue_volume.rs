@@ -66,3 +66,43 @@ fn default_particles_hold_the_volume_of_a_nu_045_organ_like_the_constraints() {
         constraints * 100.0
     );
 }
+
+/// `Body::volume` (the volume the boundary surface encloses) is the sum of the signed volumes
+/// of the tetrahedra at rest, deformed, and with tetrahedra inverted.
+#[test]
+fn the_body_volume_is_the_sum_of_its_tetrahedra() {
+    let mut world = World::new(Settings::default()).unwrap();
+    let id = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
+    let b = world.body(id).unwrap();
+    let (rest, tets) = (b.rest_positions().to_vec(), b.tets().to_vec());
+    let sum = |x: &[tissuesim::Vec3]| common::tet_volumes(x, &tets).iter().sum::<Real>();
+    let mut seed = 7u64;
+    let mut noise = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
+    };
+    let scale = common::bounds(&rest).1 - common::bounds(&rest).0;
+    for amplitude in [0.0, 0.01, 0.2] {
+        let x: Vec<_> = rest
+            .iter()
+            .map(|p| p + scale.map(|s| s * amplitude * noise()))
+            .collect();
+        let v = vec![tissuesim::Vec3::zeros(); x.len()];
+        world.set_body_state(id, &x, &v).unwrap();
+        let (got, want) = (world.body(id).unwrap().volume(), sum(&x));
+        assert!(
+            (got - want).abs()
+                <= 1e-12
+                    * common::tet_volumes(&x, &tets)
+                        .iter()
+                        .map(|v| v.abs())
+                        .sum::<Real>(),
+            "amplitude {amplitude}: {got} against {want}"
+        );
+        if amplitude == 0.0 {
+            assert!((got / world.body(id).unwrap().rest_volume() - 1.0).abs() < 1e-12);
+        }
+    }
+}
