@@ -1,59 +1,58 @@
 //! XPBD tetrahedral volume constraint (eq. 13 of the paper): `C = V(p1..p4) - V0 = 0`.
 
-use crate::math::{Real, Vec3};
+use crate::math::{tet_volume, Real, Vec3};
 
-/// The projection of one tetrahedron's volume constraint.
+/// Project one tetrahedron's volume constraint.
 ///
-/// * `p` — predicted positions (m) of its four particles;
-/// * `w` — their inverse masses (1/kg; 0 for fixed particles);
+/// * `p` — predicted positions (m), updated in place for the four nodes `tet`;
+/// * `w` — inverse masses (1/kg; 0 for fixed particles);
 /// * `rest_volume` — `V0` (m³);
 /// * `alpha_tilde` — compliance divided by the squared substep, `α / h²` (m³/Pa / s² · …);
 ///   0 makes the constraint hard;
 /// * `lambda` — the constraint's accumulated multiplier within this substep, updated.
 ///
-/// Returns the constraint value `C` (m³) before the projection and the four position
-/// corrections (m; `None` when no particle can move).
+/// Returns the constraint value `C` (m³) before the projection.
 #[inline]
-pub fn volume_tet_correction(
-    [pa, pb, pc, pd]: [Vec3; 4],
-    [wa, wb, wc, wd]: [Real; 4],
+pub fn project_volume_tet(
+    p: &mut [Vec3],
+    w: &[Real],
+    tet: [u32; 4],
     rest_volume: Real,
     alpha_tilde: Real,
     lambda: &mut Real,
-) -> (Real, Option<[Vec3; 4]>) {
+) -> Real {
+    let [a, b, c, d] = tet.map(|k| k as usize);
+    let (pa, pb, pc, pd) = (p[a], p[b], p[c], p[d]);
     let g1 = (pc - pa).cross(&(pd - pa)) / 6.0;
     let g2 = (pd - pa).cross(&(pb - pa)) / 6.0;
     let g3 = (pb - pa).cross(&(pc - pa)) / 6.0;
     let g0 = -(g1 + g2 + g3);
+    let (wa, wb, wc, wd) = (w[a], w[b], w[c], w[d]);
     let denom = wa * g0.norm_squared()
         + wb * g1.norm_squared()
         + wc * g2.norm_squared()
         + wd * g3.norm_squared()
         + alpha_tilde;
-    // V = (b − a) · ((c − a) × (d − a)) / 6 = (b − a) · g1.
-    let c_value = (pb - pa).dot(&g1) - rest_volume;
+    let c_value = tet_volume(&pa, &pb, &pc, &pd) - rest_volume;
     if denom <= Real::MIN_POSITIVE {
-        return (c_value, None);
+        return c_value;
     }
     let dl = (-c_value - alpha_tilde * *lambda) / denom;
     *lambda += dl;
-    let dp = [
-        g0 * (wa * dl),
-        g1 * (wb * dl),
-        g2 * (wc * dl),
-        g3 * (wd * dl),
-    ];
-    (c_value, Some(dp))
+    p[a] += g0 * (wa * dl);
+    p[b] += g1 * (wb * dl);
+    p[c] += g2 * (wc * dl);
+    p[d] += g3 * (wd * dl);
+    c_value
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::tet_volume;
 
     #[test]
     fn hard_constraint_restores_volume_of_a_single_tet() {
-        let mut p = [
+        let mut p = vec![
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(1.0, 0.0, 0.0),
             Vec3::new(0.0, 1.0, 0.0),
@@ -63,9 +62,7 @@ mod tests {
         let v0 = 1.0 / 6.0;
         let mut lambda = 0.0;
         for _ in 0..20 {
-            if let (_, Some(dp)) = volume_tet_correction(p, w, v0, 0.0, &mut lambda) {
-                p.iter_mut().zip(dp).for_each(|(x, d)| *x += d);
-            }
+            project_volume_tet(&mut p, &w, [0, 1, 2, 3], v0, 0.0, &mut lambda);
         }
         let v = tet_volume(&p[0], &p[1], &p[2], &p[3]);
         assert!((v - v0).abs() < 1e-12 * v0, "{v} vs {v0}");
