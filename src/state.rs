@@ -136,6 +136,23 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// Bytes of a state of `bodies` (particle count, cut entries of each) and `tools` (grasp
+/// attachments, needle holds of each).
+fn layout_size(
+    bodies: impl Iterator<Item = (usize, usize)>,
+    tools: impl Iterator<Item = (usize, usize)>,
+) -> usize {
+    let bodies: usize = bodies
+        .map(|(particles, cuts)| 4 + particles * PARTICLE_BYTES + 8 + 4 * cuts)
+        .sum();
+    let tools: usize = tools
+        .map(|(attachments, holds)| {
+            TOOL_BYTES + attachments * ATTACHMENT_BYTES + holds * HOLD_BYTES
+        })
+        .sum();
+    HEADER + bodies + tools + 8
+}
+
 fn too_short() -> Error {
     Error::BadState("the state is too short for what it declares".into())
 }
@@ -192,24 +209,12 @@ impl WorldState {
 
     /// Size in bytes of what [`WorldState::to_bytes`] writes.
     pub fn byte_size(&self) -> usize {
-        let bodies: usize = self
-            .bodies
-            .iter()
-            .map(|b| {
-                let cuts = b.cuts.as_ref().map_or(0, |c| c.0.len() + c.1.len());
-                4 + b.particles.x.len() * PARTICLE_BYTES + 8 + 4 * cuts
-            })
-            .sum();
-        let tools: usize = self
-            .tools
-            .iter()
-            .map(|t| {
-                TOOL_BYTES
-                    + t.grasp.attachments.len() * ATTACHMENT_BYTES
-                    + t.needle.holds.len() * HOLD_BYTES
-            })
-            .sum();
-        HEADER + bodies + tools + 8
+        let bodies = self.bodies.iter().map(|b| {
+            let cuts = b.cuts.as_ref().map_or(0, |c| c.0.len() + c.1.len());
+            (b.particles.x.len(), cuts)
+        });
+        let tools = (self.tools.iter()).map(|t| (t.grasp.attachments.len(), t.needle.holds.len()));
+        layout_size(bodies, tools)
     }
 
     /// Read a state written by [`WorldState::to_bytes`]. Checks the magic bytes, the version,
@@ -323,24 +328,17 @@ impl WorldState {
 }
 
 impl World {
-    /// Size in bytes of the state [`World::save_state`] writes now.
+    /// Size in bytes of the state [`World::save_state`] writes now (computed from the world,
+    /// without taking its state).
     pub fn state_size(&self) -> usize {
-        let particles: usize = self.bodies.iter().map(|b| b.particle_count()).sum();
-        let cuts: usize = self
-            .bodies
-            .iter()
-            .filter_map(crate::cut::cut_sets)
-            .map(|c| c.0.len() + c.1.len())
-            .sum();
-        let extras: usize = (self.tools.iter().zip(&self.grasps).zip(&self.needles))
+        let bodies = self.bodies.iter().map(|b| {
+            let cuts = crate::cut::cut_sets(b).map_or(0, |c| c.0.len() + c.1.len());
+            (b.particle_count(), cuts)
+        });
+        let tools = (self.tools.iter().zip(&self.grasps).zip(&self.needles))
             .filter(|((t, _), _)| t.is_some())
-            .map(|((_, g), n)| {
-                TOOL_BYTES
-                    + g.attachments.len() * ATTACHMENT_BYTES
-                    + n.as_ref().map_or(0, |n| n.holds.len() * HOLD_BYTES)
-            })
-            .sum();
-        HEADER + self.bodies.len() * (4 + 8) + particles * PARTICLE_BYTES + 4 * cuts + extras + 8
+            .map(|((_, g), n)| (g.attachments.len(), n.as_ref().map_or(0, |n| n.holds.len())));
+        layout_size(bodies, tools)
     }
 
     /// Append the world's dynamic state ([`World::state`]) to `out` in the format of
