@@ -781,6 +781,11 @@ int main(void) {
     double t = 0;
     CHECK_OK(ts_world_time(world, &t));
     CHECK(fabs(t - (double)(press + steps) * settings.dt) < 1e-12);
+    /* The jump speed: a quarter of the speed bound (250 body sizes per second; the block's size,
+     * its diagonal, is between one and two edges). */
+    double jump = 0;
+    CHECK_OK(ts_world_tool_jump_speed(world, &jump));
+    CHECK(jump > 0.25 * 250.0 * CELLS * h && jump < 0.25 * 250.0 * 2.0 * CELLS * h);
     uint64_t diverged = 99;
     CHECK_OK(ts_world_diverged_steps(world, &diverged));
     CHECK(diverged == 0);

@@ -564,6 +564,18 @@ enum ts_status ts_world_settle(struct ts_world *world);
 enum ts_status ts_world_time(const struct ts_world *world, double *out_time);
 
 /**
+ * The fastest (m/s) a tool may move and still be swept across the substeps: a faster pose
+ * change (a tracking glitch) is a jump, and the tool is placed at its new pose at once, the
+ * tissue it lands in leaving it at ts_settings.max_depenetration_speed. A quarter of the
+ * divergence speed bound of the smallest body; infinite while the world has no body.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_speed` is NULL or writable.
+ */
+enum ts_status ts_world_tool_jump_speed(const struct ts_world *world, double *out_speed);
+
+/**
  * Number of bodies in the world (their ids are 0 .. count-1).
  *
  * # Safety

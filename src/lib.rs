@@ -66,5 +66,5 @@ pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use needle::{NeedleOptions, NeedleState};
 pub use neighbours::MAX_NEIGHBOURS;
 pub use settings::{ContactMode, DivergenceLimits, Settings};
-pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World};
+pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World, TOOL_JUMP_FRACTION};
 pub use world_state::WorldState;

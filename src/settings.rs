@@ -82,12 +82,13 @@ pub struct Settings {
     /// How tool–tissue contact is detected.
     pub contact_mode: ContactMode,
     /// Largest speed (m/s) at which a tool contact removes a penetration that was already
-    /// there at the start of a substep: a substep moves a particle (or a surface triangle's
-    /// contact point) along the contact normal by at most its own motion in that substep plus
-    /// `max_depenetration_speed · h`, so a tool that jumps into the tissue (a haptic glitch) is
-    /// left by the particles gently over the following steps instead of flinging them out
-    /// (PhysX's `maxDepenetrationVelocity`), while tissue that moves into a tool is stopped
-    /// whole. Normal probing is far slower than the default.
+    /// there at the start of a substep: after a contact correction, a particle (or a surface
+    /// triangle's contact point) moves along the contact normal in that substep by at most the
+    /// tool's own motion along it plus `max_depenetration_speed · h`. A tool that jumps into
+    /// the tissue (a haptic glitch, see [`World::tool_jump_speed`](crate::World::tool_jump_speed))
+    /// is left by the particles gently over the following steps instead of flinging them out
+    /// (PhysX's `maxDepenetrationVelocity`), while the tool pushes the tissue at its own speed
+    /// and tissue that moves into a tool is stopped whole.
     pub max_depenetration_speed: Real,
     /// Enable contact between particles of the same body (off by default).
     pub self_contact: bool,

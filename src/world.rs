@@ -15,6 +15,13 @@ use crate::render::{RenderMesh, RenderSurface};
 use crate::settings::Settings;
 use std::sync::Arc;
 
+/// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
+/// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along
+/// and compressed tissue springs back (measured in `tests/issue_robustness.rs`, friction 1,
+/// random sweeps at up to 12 m/s inside the default organ: tissue at up to 42 m/s, 3.5×), so
+/// the tool must stay well below the bound for the tissue to stay within it.
+pub const TOOL_JUMP_FRACTION: Real = 0.25;
+
 /// Identifies a body inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct BodyId(pub u32);
@@ -439,10 +446,33 @@ impl World {
         Ok(())
     }
 
+    /// The fastest (m/s) a tool may move and still be swept across the substeps, pushing the
+    /// tissue along: [`TOOL_JUMP_FRACTION`] of the divergence bound on particle speed
+    /// (`divergence.max_speed` body sizes per second, the smallest over the bodies). A faster
+    /// pose change is a jump (a tracking glitch): the tissue it would push along could move
+    /// faster than the bound and fail the step, so [`World::step`] places the tool at its new
+    /// pose at once, and the tissue it lands in leaves it at
+    /// [`Settings::max_depenetration_speed`]. Infinite when the speed bound is off or the world
+    /// has no body.
+    pub fn tool_jump_speed(&self) -> Real {
+        let bound = self.settings.divergence.max_speed;
+        let slowest = (self.bodies.iter())
+            .map(|b| bound * b.model.size)
+            .fold(Real::INFINITY, Real::min);
+        TOOL_JUMP_FRACTION * slowest
+    }
+
+    /// The distance (m) beyond which a tool's pose change in one step is a jump:
+    /// [`World::tool_jump_speed`] times `dt`.
+    pub(crate) fn tool_jump_distance(&self) -> Real {
+        self.tool_jump_speed() * self.settings.dt
+    }
+
     /// Substeps the next step needs, and whether `max_substeps` clamped that number: enough
     /// for the explicit stability limit of the stiffest body, and enough that no tool moves
     /// (translation plus rotation at its bounding radius) more than one particle radius per
-    /// substep, so that a large pose jump is swept rather than teleported.
+    /// substep, so that a fast tool is swept rather than teleported; a jump (faster than
+    /// [`World::tool_jump_speed`]) is not swept.
     pub fn substeps_needed(&self) -> (u32, bool) {
         let s = &self.settings;
         let mut h_max = Real::INFINITY;
@@ -458,10 +488,9 @@ impl World {
         }
         let stable = (s.dt / (s.stability_margin * h_max)).ceil();
         let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
-        for t in self.tools.iter().flatten() {
-            let travel = (t.target.position - t.pose.position).norm()
-                + t.pose.orientation.angle_to(&t.target.orientation) * t.bounding_radius;
-            let sweep = (travel / radius).ceil();
+        let jump = self.tool_jump_distance();
+        for t in self.tools.iter().flatten().filter(|t| t.travel() <= jump) {
+            let sweep = (t.travel() / radius).ceil();
             if sweep.is_finite() {
                 needed = needed.max(sweep.min(u32::MAX as Real) as u32);
             }

@@ -346,6 +346,14 @@ fn null_parameters() {
             ("step world", ts_world_step(nw, null_mut())),
             ("time world", ts_world_time(nc, &mut d)),
             ("time out", ts_world_time(w, null_mut())),
+            (
+                "tool_jump_speed world",
+                ts_world_tool_jump_speed(nc, &mut d),
+            ),
+            (
+                "tool_jump_speed out",
+                ts_world_tool_jump_speed(w, null_mut()),
+            ),
             ("body_count world", ts_world_body_count(nc, &mut u)),
             ("body_count out", ts_world_body_count(w, null_mut())),
             ("tool_count world", ts_world_tool_count(nc, &mut u)),

@@ -218,6 +218,29 @@ fn a_blade_tool_cuts_along_its_swept_edge() {
         )
         .unwrap();
     assert!(matches!(w.make_blade(ball), Err(Error::InvalidArgument(_))));
+    // A blade faster than the jump speed (the whole stroke in one step) still cuts along its
+    // whole path: only pushing tools are placed instead of swept.
+    let (mut fast, fb) = bar(1);
+    let start = w.tool(blade).unwrap().pose();
+    let start = Pose {
+        position: Vec3::new(start.position.x, 0.05, 0.0),
+        ..start
+    };
+    let fast_blade = fast
+        .add_tool(
+            w.tool(blade).unwrap().shape().clone(),
+            start,
+            &ToolOptions::default(),
+        )
+        .unwrap();
+    fast.make_blade(fast_blade).unwrap();
+    let mut end = start;
+    end.position.y = -0.05;
+    assert!(0.1 > fast.tool_jump_speed() * fast.settings().dt, "a jump");
+    fast.set_tool_pose(fast_blade, end).unwrap();
+    let one_step = fast.step().unwrap().cut.pairs;
+    assert_eq!(one_step, fast.body(fb).unwrap().cut_counts().0);
+    assert!(one_step > 0, "a fast blade cut nothing");
     let nan = Blade {
         from: [Vec3::new(Real::NAN, 0.0, 0.0), Vec3::zeros()],
         to: [Vec3::zeros(), Vec3::x()],

@@ -383,6 +383,13 @@ impl Tool {
         })
     }
 
+    /// How far (m) the tool moves in the coming step: its translation from the pose to the
+    /// target plus its rotation (rad) times its bounding radius.
+    pub(crate) fn travel(&self) -> Real {
+        (self.target.position - self.pose.position).norm()
+            + self.pose.orientation.angle_to(&self.target.orientation) * self.bounding_radius
+    }
+
     /// The pose reached at the end of the last step.
     pub fn pose(&self) -> Pose {
         self.pose

@@ -383,6 +383,23 @@ pub unsafe extern "C" fn ts_world_time(world: *const ts_world, out_time: *mut f6
     unsafe { world_value(world, out_time, "out_time", |w| w.time()) }
 }
 
+/// The fastest (m/s) a tool may move and still be swept across the substeps: a faster pose
+/// change (a tracking glitch) is a jump, and the tool is placed at its new pose at once, the
+/// tissue it lands in leaving it at ts_settings.max_depenetration_speed. A quarter of the
+/// divergence speed bound of the smallest body; infinite while the world has no body.
+///
+/// # Safety
+///
+/// `world` is NULL or a live handle; `out_speed` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn ts_world_tool_jump_speed(
+    world: *const ts_world,
+    out_speed: *mut f64,
+) -> ts_status {
+    // SAFETY: contract of this function.
+    unsafe { world_value(world, out_speed, "out_speed", |w| w.tool_jump_speed()) }
+}
+
 /// Number of bodies in the world (their ids are 0 .. count-1).
 ///
 /// # Safety

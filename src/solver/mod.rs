@@ -21,7 +21,8 @@
 //!    poses, needle puncture or withdrawal, time.
 //!
 //! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation). The passes read the bodies (model and state)
+//! substeps (linear position, slerp orientation); a tool faster than the divergence speed bound
+//! is placed at its new pose at once (a jump, see `World::tool_jump_distance`). The passes read the bodies (model and state)
 //! and write the [`Workspace`] (per body a `StepScratch`: predicted positions `p`, forces,
 //! multipliers; the hash grid; the surface-contact scratch; the rollback copy); only the
 //! prediction (velocities, rotations) and the final update (`v = (p − x)/h`, `x = p`) write the
@@ -54,6 +55,15 @@ impl World {
         let (n, clamped) = self.substeps_needed();
         let mut rollback = std::mem::take(&mut self.workspace.rollback);
         self.state_into(&mut rollback);
+        // A jump is not swept: the tool is placed at its target for the whole step and the
+        // tissue it lands in leaves it at `max_depenetration_speed`. A blade does not push; it
+        // cuts along its whole path, however fast.
+        let jump = self.tool_jump_distance();
+        for (t, _) in (self.tools.iter_mut().zip(&self.blades)).filter(|(_, &blade)| !blade) {
+            if let Some(t) = t.as_mut().filter(|t| t.travel() > jump) {
+                t.pose = t.target;
+            }
+        }
         let h = self.settings.dt / n as Real;
         for t in self.tools.iter_mut().flatten() {
             t.acc_impulse = Vec3::zeros();
@@ -207,7 +217,7 @@ impl World {
                             body,
                             scratch,
                             motion,
-                            (max_correction, h),
+                            max_correction,
                             it == 0,
                         ),
                         ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(

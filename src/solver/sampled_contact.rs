@@ -2,10 +2,15 @@
 //! ([`ContactMode::SampledPoints`](crate::ContactMode::SampledPoints)): the tool's surface
 //! samples, each a sphere, against the body's particles, with friction, accumulating the tool's
 //! wrench.
+//!
+//! A particle inside the tool's solid shape (after a jump, or a sweep faster than the contacts
+//! can push) is first pushed along the normal of the nearest point of the tool's surface, and
+//! meets the samples only once it is out: the samples alone would push it out of each sample
+//! separately, in directions that fight, and a particle deep inside meets none of them.
 
 use crate::body::Body;
 use crate::collision::tool::{Pose, Tool};
-use crate::constraints::contact::{project_point_sphere, ContactProjection};
+use crate::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
 use crate::solver::StepScratch;
@@ -13,7 +18,9 @@ use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
 /// `motion.1` over this substep) and the particles of `body`, with friction, each normal
-/// correction at most `max_correction` (m), and accumulate the tool's impulse and moment.
+/// correction leaving the particle's motion along the normal in this substep at most the
+/// tool's motion along it plus `max_correction` (m), and accumulate the tool's impulse and
+/// moment.
 pub(crate) fn project_sampled_contacts(
     tool: &mut Tool,
     body: &Body,
@@ -47,12 +54,35 @@ pub(crate) fn project_sampled_contacts(
             tool.acc_penetration = tool.acc_penetration.max(c.depth);
             touched = Some(contact);
         };
-        let rs = tool.sample_radius;
-        for s in 0..tool.samples.len() {
-            let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
-            if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, max_correction) {
-                let contact = sw + c.normal * rs;
-                apply(&mut p, c, contact, tool);
+        // The depenetration cap, as in the exact-shape mode: after a contact the particle moves
+        // along its normal by at most the tool's motion along it plus `max_correction` in this
+        // substep. Tissue moving into the tool is stopped whole, the tool pushes the tissue at
+        // its own speed, and older penetration (a jump into the tissue) is removed at
+        // `max_depenetration_speed`, however many samples overlap the particle.
+        let start = body.state.x[i];
+        let cap = |p: &Vec3, normal: &Vec3, contact: &Vec3| {
+            let tool_motion = contact - back.transform_point(&Point::from(*contact)).coords;
+            let pushed = tool_motion.dot(normal).max(0.0);
+            (max_correction + pushed - (p - start).dot(normal)).max(0.0)
+        };
+        let surface = tool.shape.project_point(&iso, &Point::from(p), false);
+        if surface.is_inside {
+            let on_tool = surface.point.coords;
+            let away = (p - centre).try_normalize(1e-12).unwrap_or(Vec3::y());
+            let q = p;
+            let c = push_out_of_solid(&mut p, &on_tool, &away, r, &|n| cap(&q, n, &on_tool));
+            apply(&mut p, c, on_tool, tool);
+        }
+        if !surface.is_inside || !tool.shape.contains_point(&iso, &Point::from(p)) {
+            let rs = tool.sample_radius;
+            for s in 0..tool.samples.len() {
+                let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
+                let normal = (p - sw).try_normalize(1e-12).unwrap_or(Vec3::y());
+                let limit = cap(&p, &normal, &(sw + normal * rs));
+                if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, limit) {
+                    let contact = sw + c.normal * rs;
+                    apply(&mut p, c, contact, tool);
+                }
             }
         }
         if let Some(contact) = touched {

@@ -119,8 +119,9 @@ impl std::fmt::Debug for SurfaceScratch {
 }
 
 /// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this substep)
-/// and the boundary triangles of `body` (moving its predicted positions in `predicted`), each correction at most `max_correction` (m) beyond the
-/// contact point's predicted motion towards the tool in the substep of `h` (s), in up to
+/// and the boundary triangles of `body` (moving its predicted positions in `predicted`), each
+/// correction leaving the contact point's motion along the contact direction in this substep at
+/// most the tool's own motion along it plus `max_correction` (m), in up to
 /// [`MAX_SURFACE_PASSES`] passes (until the largest correction of a pass is below
 /// [`SURFACE_PASS_TOLERANCE`] skins), and accumulate the tool's impulse and moment; `count` adds
 /// the triangles in contact in the first pass to the tool's contact count.
@@ -130,7 +131,7 @@ pub(crate) fn project_tool_surface(
     body: &Body,
     predicted: &mut StepScratch,
     (prev, cur): (&Pose, &Pose),
-    (max_correction, h): (Real, Real),
+    max_correction: Real,
     count: bool,
 ) {
     let iso = cur.isometry();
@@ -213,14 +214,19 @@ pub(crate) fn project_tool_surface(
             let moved: Vec3 = (0..3)
                 .map(|k| (predicted.p[corners[k]] - body.state.x[corners[k]]) * weights[k])
                 .sum();
-            // The cap applies to penetration older than this substep: what the contact point's
-            // predicted motion towards the tool (v h) brought in is removed whole. What the cap
-            // leaves in the first pass stays for the next substeps; the later passes remove
-            // what the neighbouring triangles' corrections pushed in beyond it, each under the
-            // same cap.
+            // The depenetration cap: after the correction the contact point moves along the
+            // contact direction by at most the tool's motion along it plus `max_correction` in
+            // this substep. Tissue moving into the tool is stopped whole, the tool pushes the
+            // tissue at its own speed, and penetration older than this substep is removed at
+            // `max_depenetration_speed` (never faster, however many substeps and triangles
+            // push). What the cap leaves in the first pass stays for the next substeps; the
+            // later passes remove what the neighbouring triangles' corrections pushed in beyond
+            // it, each under the same cap.
             let depth = contact.depth;
-            let approach: Vec3 = (0..3).map(|k| body.state.v[corners[k]] * weights[k]).sum();
-            let cap = max_correction + (-approach.dot(&contact.direction)).max(0.0) * h;
+            let tool_motion =
+                contact.point - back.transform_point(&Point::from(contact.point)).coords;
+            let pushed = tool_motion.dot(&contact.direction).max(0.0);
+            let cap = (max_correction + pushed - moved.dot(&contact.direction)).max(0.0);
             let applied = if pass == 0 {
                 let applied = depth.min(cap);
                 *left = depth - applied;
@@ -230,8 +236,6 @@ pub(crate) fn project_tool_surface(
                 (depth - *left).min(cap)
             };
             largest = largest.max(applied);
-            let tool_motion =
-                contact.point - back.transform_point(&Point::from(contact.point)).coords;
             let normal_shift = contact.direction * applied;
             let relative = moved + normal_shift - tool_motion;
             let shift = normal_shift
