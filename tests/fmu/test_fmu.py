@@ -221,6 +221,27 @@ def test_any_step_size_works(slaves, vr):
     assert fmu.getBooleanStatus(fmi2Terminated) is False
 
 
+def test_a_tracking_glitch_is_placed_not_swept(slaves, vr):
+    """A tracking glitch: the probe input jumps 9.5 cm into the organ within one 1 ms
+    communication step (95 m/s, beyond the solver's tool jump speed), is held there, then jumps
+    back out. Every step succeeds (swept at 95 m/s, the tissue pushed along failed the speed
+    bound: fmi2Discard on every step until the input moved back), the force output never
+    kicks, and the organ keeps its volume."""
+    fmu = slaves.initialised()
+    h = 1e-3
+    t = 0.0
+    for z in [Z_OUT] * 10 + [0.0] * 50 + [Z_OUT] * 50:
+        fmu.setReal([vr["tool_pz"]], [z])
+        fmu.doStep(t, h)  # raises FMICallException on fmi2Discard
+        t += h
+        y = outputs(fmu, vr)
+        assert np.all(np.isfinite(y))
+        force = np.linalg.norm(y[0:3])
+        assert force < 5.0, f"a {force} N kick at t = {t} s"
+        assert abs(y[7] - 1.0) < 0.02, f"volume ratio {y[7]} at t = {t} s"
+    assert fmu.getRealStatus(fmi2LastSuccessfulTime) == pytest.approx(t, abs=1e-12)
+
+
 def test_other_tool_shapes(slaves, vr):
     s = math.sqrt(0.5)
     for shape in (1, 2, 3):
