@@ -21,12 +21,12 @@
 //!    poses, needle puncture or withdrawal, time.
 //!
 //! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation); a tool faster than the divergence speed bound
-//! is placed at its new pose at once (a jump, see `World::tool_jump_distance`). The passes read the bodies (model and state)
-//! and write the [`Workspace`] (per body a `StepScratch`: predicted positions `p`, forces,
-//! multipliers; the hash grid; the surface-contact scratch; the rollback copy); only the
-//! prediction (velocities, rotations) and the final update (`v = (p − x)/h`, `x = p`) write the
-//! bodies' state.
+//! substeps (linear position, slerp orientation); a tool faster than
+//! [`World::tool_jump_speed`] is placed at its new pose at once (a jump; blades excepted). The
+//! passes read the bodies (model and state) and write the [`Workspace`] (per body a
+//! `StepScratch`: predicted positions `p`, forces, multipliers; the hash grid; the
+//! surface-contact scratch; the rollback copy); only the prediction (velocities, rotations) and
+//! the final update (`v = (p − x)/h`, `x = p`) write the bodies' state.
 
 mod organ_contact;
 mod predict;
