@@ -15,13 +15,14 @@ pub struct ContactProjection {
 }
 
 /// Push a particle at `p` out of a sphere of radius `radius` (m) centred at `centre` (m), by at
-/// most `max_correction` (m): the paper's point–point contact with a tool sample.
+/// most `cap(normal)` (m) along the unit `normal` of the push (evaluated only on contact): the
+/// paper's point–point contact with a tool sample.
 #[inline]
 pub fn project_point_sphere(
     p: &mut Vec3,
     centre: &Vec3,
     radius: Real,
-    max_correction: Real,
+    cap: impl Fn(&Vec3) -> Real,
 ) -> Option<ContactProjection> {
     let offset = *p - centre;
     let d2 = offset.norm_squared();
@@ -31,7 +32,7 @@ pub fn project_point_sphere(
     let d = d2.sqrt();
     let normal = if d > 1e-12 { offset / d } else { Vec3::y() };
     let depth = radius - d;
-    let correction = depth.min(max_correction);
+    let correction = depth.min(cap(&normal));
     *p += normal * correction;
     Some(ContactProjection {
         normal,

@@ -77,8 +77,8 @@ pub(crate) fn project_sampled_contacts(
             let rs = tool.sample_radius;
             for s in 0..tool.samples.len() {
                 let sw = iso.transform_point(&Point::from(tool.samples[s])).coords;
-                let normal = (p - sw).try_normalize(1e-12).unwrap_or(Vec3::y());
-                let limit = cap(&p, &normal, &(sw + normal * rs));
+                let q = p;
+                let limit = |n: &Vec3| cap(&q, n, &(sw + n * rs));
                 if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, limit) {
                     let contact = sw + c.normal * rs;
                     apply(&mut p, c, contact, tool);
