@@ -45,7 +45,13 @@ use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
 use crate::settings::ContactMode;
 use crate::world::{StepReport, World};
-use parry3d_f64::math::Point;
+use parry3d_f64::math::{Isometry, Point};
+
+/// How far (m) the point of a tool now at `point` moved in this substep: `back` maps a point
+/// attached to the tool at the substep's end to where it was at its start.
+fn tool_motion_at(back: &Isometry<Real>, point: &Vec3) -> Vec3 {
+    point - back.transform_point(&Point::from(*point)).coords
+}
 
 impl World {
     /// Advance the world by `settings.dt`. When a body becomes non-finite or leaves the

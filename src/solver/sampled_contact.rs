@@ -13,7 +13,7 @@ use crate::collision::tool::{Pose, Tool};
 use crate::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
-use crate::solver::StepScratch;
+use crate::solver::{tool_motion_at, StepScratch};
 use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
@@ -48,7 +48,7 @@ pub(crate) fn project_sampled_contacts(
         // The last contact point on the tool surface, where the impulse acts on the tool.
         let mut touched: Option<Vec3> = None;
         let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
-            let tool_motion = contact - back.transform_point(&Point::from(contact)).coords;
+            let tool_motion = tool_motion_at(&back, &contact);
             let rel = (*p - body.state.x[i]) - tool_motion;
             *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
             tool.acc_penetration = tool.acc_penetration.max(c.depth);
@@ -61,7 +61,7 @@ pub(crate) fn project_sampled_contacts(
         // `max_depenetration_speed`, however many samples overlap the particle.
         let start = body.state.x[i];
         let cap = |p: &Vec3, normal: &Vec3, contact: &Vec3| {
-            let tool_motion = contact - back.transform_point(&Point::from(*contact)).coords;
+            let tool_motion = tool_motion_at(&back, contact);
             let pushed = tool_motion.dot(normal).max(0.0);
             (max_correction + pushed - (p - start).dot(normal)).max(0.0)
         };

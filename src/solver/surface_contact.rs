@@ -31,7 +31,7 @@ use crate::body::Body;
 use crate::collision::tool::{Pose, Tool, ToolShape};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
-use crate::solver::StepScratch;
+use crate::solver::{tool_motion_at, StepScratch};
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CSOPoint, GJKResult, VoronoiSimplex};
@@ -223,8 +223,7 @@ pub(crate) fn project_tool_surface(
             // later passes remove what the neighbouring triangles' corrections pushed in beyond
             // it, each under the same cap.
             let depth = contact.depth;
-            let tool_motion =
-                contact.point - back.transform_point(&Point::from(contact.point)).coords;
+            let tool_motion = tool_motion_at(&back, &contact.point);
             let pushed = tool_motion.dot(&contact.direction).max(0.0);
             let cap = (max_correction + pushed - moved.dot(&contact.direction)).max(0.0);
             let applied = if pass == 0 {
