@@ -230,19 +230,13 @@ fn far_tool_poses_neither_hang_nor_poison() {
     let _ = w;
 }
 
-/// Random tool motion inside the hanging organ, friction 1: with `walk` the tool moves by up to
-/// `walk` (m) along each axis a step (swept across the substeps), without it it jumps to a
-/// random point every step (10 cm a step: 100 m/s). Every step either succeeds with the organ
-/// within the divergence limits or fails as `Diverged` and changes nothing; the world then
-/// steps again from the state saved before the abuse. Returns the number of diverged steps and
-/// the largest particle speed (m/s) after a successful step.
-fn random_motion(mode: ContactMode, steps: usize, walk: Option<Real>) -> (u64, Real) {
-    let settings = Settings {
+/// The hanging organ in contact `mode` and a 1.5 cm sphere with friction 1, 0.3 m in front of
+/// it (out of contact).
+fn organ_and_sticky_probe(mode: ContactMode) -> (World, tissuesim::ToolId) {
+    let mut w = organ_world(Settings {
         contact_mode: mode,
         ..Settings::default()
-    };
-    let limits = settings.divergence;
-    let mut w = organ_world(settings);
+    });
     let options = ToolOptions {
         friction_static: 1.0,
         friction_kinetic: 1.0,
@@ -252,6 +246,19 @@ fn random_motion(mode: ContactMode, steps: usize, walk: Option<Real>) -> (u64, R
     let t = w
         .add_tool(ToolShape::Sphere { radius: 0.015 }, away, &options)
         .unwrap();
+    (w, t)
+}
+
+/// Random tool motion inside the hanging organ, friction 1: with `walk` the tool moves by up to
+/// `walk` (m) along each axis a step (swept across the substeps), without it it jumps to a
+/// random point every step (10 cm a step: 100 m/s). Every step either succeeds with the organ
+/// within the divergence limits or fails as `Diverged` and changes nothing; the world then
+/// steps again from the state saved before the abuse. Returns the number of diverged steps and
+/// the largest particle speed (m/s) after a successful step.
+fn random_motion(mode: ContactMode, steps: usize, walk: Option<Real>) -> (u64, Real) {
+    let (mut w, t) = organ_and_sticky_probe(mode);
+    let limits = w.settings().divergence;
+    let away = w.tool(t).unwrap().pose();
     let mut seed = 0x9e37_79b9_7f4a_7c15u64;
     let mut rnd = || {
         seed ^= seed << 13;
@@ -337,23 +344,7 @@ fn random_far_jumps_and_fast_sweeps_inside_the_organ_never_diverge() {
 #[test]
 fn a_tool_jumping_into_the_organ_is_left_gently() {
     for mode in [ContactMode::ExactShape, ContactMode::SampledPoints] {
-        let settings = Settings {
-            contact_mode: mode,
-            ..Settings::default()
-        };
-        let mut w = organ_world(settings);
-        let options = ToolOptions {
-            friction_static: 1.0,
-            friction_kinetic: 1.0,
-            ..ToolOptions::default()
-        };
-        let t = w
-            .add_tool(
-                ToolShape::Sphere { radius: 0.015 },
-                Pose::at(Vec3::new(0.0, 0.0, 0.3)),
-                &options,
-            )
-            .unwrap();
+        let (mut w, t) = organ_and_sticky_probe(mode);
         w.set_tool_pose(t, Pose::at(Vec3::zeros())).unwrap();
         let b = tissuesim::BodyId(0);
         let inside = |w: &World| {
