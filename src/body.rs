@@ -542,7 +542,7 @@ impl Body {
             let mut dsum = Vec3::zeros();
             for e in self.model.nbr.range(i) {
                 let j = self.model.nbr.index[e] as usize;
-                let d = self.model.nbr.gradient[e];
+                let d = self.model.nbr.gradient.get(e);
                 let hg = self.elastic.hourglass * vi * self.model.nbr.hourglass_weight[e];
                 k[j] += pwave * vi * d.norm_squared() + hg;
                 k[i] += hg;

@@ -62,7 +62,7 @@ pub fn integration_residual(nbr: &Neighbourhoods, volume: &[Real], b: &[Vec3]) -
     let mut r: Vec<Vec3> = b.iter().map(|v| -v).collect();
     for (i, vi) in volume.iter().enumerate() {
         for e in nbr.range(i) {
-            let g = nbr.gradient[e] * *vi;
+            let g = nbr.gradient.get(e) * *vi;
             r[nbr.index[e] as usize] += g;
             r[i] -= g;
         }
@@ -99,8 +99,8 @@ pub fn correct_gradients(
         op.projected_differences(i, &lambda, &mut y);
         delta.extend(y.iter().map(|yj| yj * *vi));
     }
-    for (g, d) in nbr.gradient.iter_mut().zip(&delta) {
-        *g += d;
+    for (e, d) in delta.iter().enumerate() {
+        nbr.gradient.set(e, nbr.gradient.get(e) + d);
     }
     let after = norm(&integration_residual(nbr, volume, &b)) / scale;
     CorrectionReport {
@@ -135,7 +135,7 @@ impl<'a> Operator<'a> {
         let mut diagonal = vec![0.0; n];
         for (i, vi) in volume.iter().enumerate() {
             let range = nbr.range(i);
-            let u = &nbr.rest_offset[range];
+            let u: Vec<Vec3> = nbr.rest_offset.iter_range(range).collect();
             let gram: Mat3 = u.iter().map(|u| u * u.transpose()).sum();
             // The neighbourhood builder guarantees a well-conditioned moment matrix, hence
             // three independent offsets and an invertible Gram matrix.
@@ -144,7 +144,7 @@ impl<'a> Operator<'a> {
             // Π_jj = 1 − u_jᵀ G⁻¹ u_j; 1ᵀ Π 1 = k − sᵀ G⁻¹ s with s = Σ_j u_j.
             let s: Vec3 = u.iter().sum();
             diagonal[i] += w * (u.len() as Real - s.dot(&(ginv * s)));
-            for (e, uj) in nbr.range(i).zip(u) {
+            for (e, uj) in nbr.range(i).zip(&u) {
                 diagonal[nbr.index[e] as usize] += w * (1.0 - uj.dot(&(ginv * uj)));
             }
             gram_inverse.push(ginv);
@@ -165,13 +165,13 @@ impl<'a> Operator<'a> {
         let mut ut_y = Mat3::zeros();
         for e in range.clone() {
             let d = lambda[nbr.index[e] as usize] - lambda[i];
-            ut_y += nbr.rest_offset[e] * d.transpose();
+            ut_y += nbr.rest_offset.get(e) * d.transpose();
             y.push(d);
         }
         // Π y = y − U (UᵀU)⁻¹ Uᵀ y; row j of U (UᵀU)⁻¹ Uᵀ y is u_jᵀ G⁻¹ (Uᵀ y).
         let c = self.gram_inverse[i] * ut_y;
         for (e, yj) in range.zip(y.iter_mut()) {
-            *yj -= c.transpose() * nbr.rest_offset[e];
+            *yj -= c.transpose() * nbr.rest_offset.get(e);
         }
     }
 

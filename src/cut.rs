@@ -207,7 +207,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
             }
         }
         None => {
-            model.nbr.gradient.copy_from_slice(&original.nbr.gradient);
+            model.nbr.gradient.copy_from(&original.nbr.gradient);
             model
                 .nbr
                 .hourglass_weight
@@ -295,7 +295,7 @@ fn recompute_row(nbr: &mut Neighbourhoods, pair_cut: &[bool], i: usize) -> bool 
     let (mut wsum, mut alive) = (0.0, 0);
     for e in range.clone() {
         if !pair_cut[e] {
-            let u = nbr.rest_offset[e];
+            let u = nbr.rest_offset.get(e);
             let w = weight(&u);
             a += u * u.transpose() * w;
             wsum += w;
@@ -307,15 +307,15 @@ fn recompute_row(nbr: &mut Neighbourhoods, pair_cut: &[bool], i: usize) -> bool 
         .then(|| a.try_inverse())
         .flatten();
     for e in range {
-        let u = nbr.rest_offset[e];
+        let u = nbr.rest_offset.get(e);
         match inverse {
             Some(inv) if !pair_cut[e] => {
                 let w = weight(&u);
-                nbr.gradient[e] = inv * u * w;
+                nbr.gradient.set(e, inv * u * w);
                 nbr.hourglass_weight[e] = w / wsum / u.norm_squared();
             }
             _ => {
-                nbr.gradient[e] = Vec3::zeros();
+                nbr.gradient.set(e, Vec3::zeros());
                 nbr.hourglass_weight[e] = 0.0;
             }
         }

@@ -26,8 +26,9 @@
 //! the pair's elastic stiffness (N/m): stiffness-proportional (Rayleigh β) damping that is
 //! central (momentum conserving) and zero under rigid motion.
 
+use crate::lanes::{F4, LANES, M4, V4};
 use crate::math::{Mat3, Quat, Real, Vec3};
-use crate::neighbours::Neighbourhoods;
+use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
 use crate::parallel::{Pool, SharedSlice};
 use nalgebra::Quaternion;
 
@@ -68,8 +69,8 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
     let mut f = Mat3::identity();
     for e in nbr.range(i) {
         let j = nbr.index[e] as usize;
-        let du = x[j] - xi - nbr.rest_offset[e];
-        f += du * nbr.gradient[e].transpose();
+        let du = x[j] - xi - nbr.rest_offset.get(e);
+        f += du * nbr.gradient.get(e).transpose();
     }
     f
 }
@@ -211,11 +212,19 @@ pub fn accumulate_forces(
     let nbr = input.nbr;
     let n = nbr.particle_count();
     if pool.threads() == 1 {
+        let mut buffer = PairBuffer::new();
         for i in 0..n {
             let range = nbr.range(i);
             let pf = &mut pair_force[range.clone()];
-            let fi =
-                particle_pair_forces(model, input, i, &mut rotation[i], rotation_iterations, pf);
+            let fi = particle_pair_forces(
+                model,
+                input,
+                i,
+                &mut rotation[i],
+                rotation_iterations,
+                &mut buffer,
+                pf,
+            );
             for (&j, g) in nbr.index[range].iter().zip(pf.iter()) {
                 force[j as usize] -= g;
             }
@@ -238,6 +247,7 @@ pub fn accumulate_forces(
                 own.range(particles.clone()),
             )
         };
+        let mut buffer = PairBuffer::new();
         for (k, i) in particles.enumerate() {
             let range = nbr.range(i);
             let local = range.start - first_pair..range.end - first_pair;
@@ -247,6 +257,7 @@ pub fn accumulate_forces(
                 i,
                 &mut rot[k],
                 rotation_iterations,
+                &mut buffer,
                 &mut pf[local],
             );
         }
@@ -275,9 +286,30 @@ pub fn accumulate_forces(
     });
 }
 
+/// Pair data of one particle held between the passes of [`particle_pair_forces`], four pairs a
+/// chunk: the current offsets `x_ij` (m) and hourglass residuals `ε_ij` (m).
+struct PairBuffer {
+    offset: [V4; MAX_CHUNKS],
+    residual: [V4; MAX_CHUNKS],
+}
+
+/// Chunks of four pairs a particle may have: the largest neighbourhood that
+/// [`crate::neighbours::build`] accepts.
+const MAX_CHUNKS: usize = MAX_FIXED_NEIGHBOURS.div_ceil(LANES);
+
+impl PairBuffer {
+    fn new() -> Self {
+        PairBuffer {
+            offset: [V4::default(); MAX_CHUNKS],
+            residual: [V4::default(); MAX_CHUNKS],
+        }
+    }
+}
+
 /// Particle `i`'s part of the first pass: its deformation gradient, rotation (warm-started in
 /// `q`) and stress, the force `g_ij` on `i` of each of its pairs written to `pair_force` (one
-/// entry per pair of `i`, also used as scratch), and their sum returned.
+/// entry per pair of `i`), and their sum returned. Three passes over the pairs of `i`, four
+/// pairs at a time (see [`crate::lanes`]).
 #[inline]
 fn particle_pair_forces(
     model: &ElasticModel,
@@ -285,62 +317,236 @@ fn particle_pair_forces(
     i: usize,
     q: &mut Quat,
     rotation_iterations: u32,
+    buffer: &mut PairBuffer,
     pair_force: &mut [Vec3],
 ) -> Vec3 {
     let nbr = input.nbr;
-    let x = input.x;
     let range = nbr.range(i);
     let index = &nbr.index[range.clone()];
-    let rest = &nbr.rest_offset[range.clone()];
-    let grad = &nbr.gradient[range.clone()];
+    let u = nbr.rest_offset.slices(range.clone());
+    let d = nbr.gradient.slices(range.clone());
     let hw = &nbr.hourglass_weight[range];
-    let xi = x[i];
-    // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next pass.
-    let mut f = Mat3::identity();
-    for (((&j, u), d), s) in index.iter().zip(rest).zip(grad).zip(pair_force.iter_mut()) {
-        let xij = x[j as usize] - xi;
-        f += (xij - u) * d.transpose();
-        *s = xij;
+    let pairs = index.len();
+    let chunks = pairs.div_ceil(LANES);
+    // Lanes past the last pair take j = i (offset 0) and load zero u, d and weight: they add
+    // nothing anywhere below.
+    let neighbours = |k: usize| -> [usize; LANES] {
+        match index.get(LANES * k..LANES * k + LANES) {
+            Some(c) => [c[0], c[1], c[2], c[3]].map(|j| j as usize),
+            None => std::array::from_fn(|l| index.get(LANES * k + l).map_or(i, |&j| j as usize)),
+        }
+    };
+    let offset = &mut buffer.offset[..chunks];
+    let residual = &mut buffer.residual[..chunks];
+    // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next passes.
+    let xi = V4::splat(&input.x[i]);
+    let mut fsum = M4::default();
+    for (k, o) in offset.iter_mut().enumerate() {
+        *o = V4::gather(input.x, &neighbours(k)) - xi;
+        let du = *o - V4::load(&u, LANES * k);
+        fsum.add_outer(&du, &V4::load(&d, LANES * k));
     }
+    let f = fsum.sum() + Mat3::identity();
     let r = extract_rotation(&f, q, rotation_iterations);
     let vi = input.volume[i];
-    // Pass 2: hourglass residuals ε = F u - x_ij (in place of x_ij) and Q = Σ c ε uᵀ;
-    // skipped without hourglass control (ε then multiplies c = 0 below).
-    let c_scale = model.hourglass * vi;
-    let mut qm = Mat3::zeros();
-    if c_scale != 0.0 {
-        for ((u, w), s) in rest.iter().zip(hw).zip(pair_force.iter_mut()) {
-            let eps = f * u - *s;
-            *s = eps;
-            qm += eps * (u.transpose() * (c_scale * w));
+    // Pass 2: hourglass residuals ε = F u - x_ij and Q = Σ c ε uᵀ; skipped without hourglass
+    // control (ε then multiplies c = 0 below).
+    let c_scale = F4::splat(model.hourglass * vi);
+    let mut qsum = M4::default();
+    if model.hourglass != 0.0 {
+        let fl = M4::splat(&f);
+        for (k, (o, eps)) in offset.iter().zip(residual.iter_mut()).enumerate() {
+            let uk = V4::load(&u, LANES * k);
+            *eps = fl.mul(&uk) - *o;
+            let cw = F4::load(hw, LANES * k) * c_scale;
+            qsum.add_outer(eps, &uk.scale(cw));
         }
+    } else {
+        residual.fill(V4::default());
     }
     // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
-    let m = corotated_stress(&f, &r, model.lambda, model.mu) * vi + qm;
-    let damped = model.damping_stiffness > 0.0;
-    let pwave = model.p_wave_modulus();
-    let mut fi = Vec3::zeros();
-    for (((&j, d), w), s) in index.iter().zip(grad).zip(hw).zip(pair_force.iter_mut()) {
-        let j = j as usize;
-        let mut g = m * d - *s * (c_scale * w);
-        if damped {
-            let xij = x[j] - xi;
-            let len2 = xij.norm_squared();
-            if len2 > 1.0e-30 {
-                let k = pwave * vi * d.norm_squared();
-                let rate = (input.v[j] - input.v[i]).dot(&xij);
-                g += xij * (model.damping_stiffness * k * rate / len2);
-            }
+    let m = M4::splat(&(corotated_stress(&f, &r, model.lambda, model.mu) * vi + qsum.sum()));
+    let damping = model.damping_stiffness * model.p_wave_modulus() * vi;
+    let vel_i = V4::splat(&input.v[i]);
+    let mut fi = V4::default();
+    for (k, (o, eps)) in offset.iter().zip(residual.iter()).enumerate() {
+        let e = LANES * k;
+        let dk = V4::load(&d, e);
+        let cw = F4::load(hw, e) * c_scale;
+        let mut g = m.mul(&dk) - eps.scale(cw);
+        if damping > 0.0 {
+            // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
+            let len2 = o.dot(o);
+            let rate = (V4::gather(input.v, &neighbours(k)) - vel_i).dot(o);
+            let k2 = dk.dot(&dk);
+            let (len2, k2, rate) = (len2.to_array(), k2.to_array(), rate.to_array());
+            let s = F4::from_fn(|l| {
+                if len2[l] > 1.0e-30 {
+                    damping * k2[l] * rate[l] / len2[l]
+                } else {
+                    0.0
+                }
+            });
+            g += o.scale(s);
         }
-        *s = g;
+        g.store(&mut pair_force[e..(e + LANES).min(pairs)]);
         fi += g;
     }
-    fi
+    fi.sum()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::neighbours::{build, SupportRadius};
+
+    /// A jittered 5×4×4 block of points (m), with a deterministic pseudo-random jitter.
+    fn jittered_block() -> Vec<Vec3> {
+        let mut seed = 12345_u64;
+        let mut jitter = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as Real / (1u64 << 53) as Real - 0.5) * 0.3
+        };
+        let mut points = Vec::new();
+        for i in 0..5 {
+            for j in 0..4 {
+                for k in 0..4 {
+                    let p = Vec3::new(i as Real, j as Real, k as Real);
+                    points.push(p + Vec3::new(jitter(), jitter(), jitter()));
+                }
+            }
+        }
+        points
+    }
+
+    /// A smooth large deformation with some rotation of the block.
+    fn deformed(rest: &[Vec3]) -> Vec<Vec3> {
+        let rot = Quat::from_scaled_axis(Vec3::new(0.3, -0.2, 0.5));
+        rest.iter()
+            .map(|p| rot * Vec3::new(1.2 * p.x + 0.1 * p.y * p.y, 0.9 * p.y, p.z + 0.2 * p.x))
+            .collect()
+    }
+
+    /// The elastic energy (J) whose negative gradient the force pass computes:
+    /// `Σ_i v_i [μ |F_i - R_i|² + λ/2 tr(R_iᵀF_i - I)²] + Σ_i Σ_j c_ij |ε_ij|² / 2`.
+    fn energy(model: &ElasticModel, nbr: &Neighbourhoods, volume: &[Real], x: &[Vec3]) -> Real {
+        let mut total = 0.0;
+        for (i, vi) in volume.iter().enumerate() {
+            let f = deformation_gradient(nbr, x, i);
+            let r = rotation_from_svd(&f).to_rotation_matrix().into_inner();
+            let tr = (r.transpose() * f).trace() - 3.0;
+            total += vi * (model.mu * (f - r).norm_squared() + 0.5 * model.lambda * tr * tr);
+            for e in nbr.range(i) {
+                let j = nbr.index[e] as usize;
+                let eps = f * nbr.rest_offset.get(e) - (x[j] - x[i]);
+                total += 0.5 * model.hourglass * vi * nbr.hourglass_weight[e] * eps.norm_squared();
+            }
+        }
+        total
+    }
+
+    fn forces(model: &ElasticModel, input: &ForceInputs<'_>, threads: usize) -> Vec<Vec3> {
+        let n = input.x.len();
+        let mut rotation = vec![Quat::identity(); n];
+        let mut pair_force = vec![Vec3::zeros(); input.nbr.pair_count()];
+        let mut own_force = vec![Vec3::zeros(); n];
+        let mut force = vec![Vec3::zeros(); n];
+        accumulate_forces(
+            model,
+            input,
+            &mut rotation,
+            50,
+            &mut pair_force,
+            &mut own_force,
+            &mut force,
+            &Pool::new(threads),
+        );
+        force
+    }
+
+    /// The four-lane force pass is the exact negative gradient of the energy (central finite
+    /// differences), on neighbourhoods whose sizes are not all multiples of four (the padded
+    /// lanes must add nothing), and the same bits on one and two threads.
+    #[test]
+    fn forces_are_the_negative_energy_gradient_on_any_neighbourhood_size() {
+        let rest = jittered_block();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let sizes: Vec<usize> = (0..rest.len()).map(|i| nbr.range(i).len()).collect();
+        assert!(sizes.iter().any(|k| k % LANES != 0), "{sizes:?}");
+        let volume: Vec<Real> = (0..rest.len()).map(|i| 1.0 + 0.01 * i as Real).collect();
+        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.0);
+        let x = deformed(&rest);
+        let v = vec![Vec3::zeros(); x.len()];
+        let input = ForceInputs {
+            nbr: &nbr,
+            volume: &volume,
+            x: &x,
+            v: &v,
+        };
+        let f = forces(&model, &input, 1);
+        assert_eq!(f, forces(&model, &input, 2));
+        let scale = f.iter().map(|g| g.norm()).fold(0.0, Real::max);
+        let h = 1e-6;
+        for i in [0, 7, 33, 79] {
+            for c in 0..3 {
+                let (mut plus, mut minus) = (x.clone(), x.clone());
+                plus[i][c] += h;
+                minus[i][c] -= h;
+                let de =
+                    energy(&model, &nbr, &volume, &plus) - energy(&model, &nbr, &volume, &minus);
+                let expected = -de / (2.0 * h);
+                assert!(
+                    (f[i][c] - expected).abs() < 1e-6 * scale,
+                    "particle {i} component {c}: force {} against -dE/dx {expected}",
+                    f[i][c]
+                );
+            }
+        }
+    }
+
+    /// The pair dashpot: a rigid rotation's velocities give no damping force, and a
+    /// stretching velocity field gives a force that does negative work (it takes energy).
+    #[test]
+    fn pair_damping_is_zero_under_rigid_motion_and_dissipates_otherwise() {
+        let rest = jittered_block();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let volume = vec![1.0; rest.len()];
+        let damped = ElasticModel::new(1000.0, 0.3, 0.0, 0.01);
+        let spin = Vec3::new(0.2, 1.0, -0.4);
+        let rigid: Vec<Vec3> = rest.iter().map(|p| spin.cross(p) + Vec3::x()).collect();
+        let stretch: Vec<Vec3> = rest
+            .iter()
+            .map(|p| Vec3::new(p.x, 0.0, -0.5 * p.z))
+            .collect();
+        let zero = vec![Vec3::zeros(); rest.len()];
+        let at = |v: &[Vec3]| {
+            let input = ForceInputs {
+                nbr: &nbr,
+                volume: &volume,
+                x: &rest,
+                v,
+            };
+            forces(&damped, &input, 1)
+        };
+        let still = at(&zero);
+        let scale = still
+            .iter()
+            .chain(&at(&stretch))
+            .map(|g| g.norm())
+            .fold(1e-300, Real::max);
+        for (a, b) in at(&rigid).iter().zip(&still) {
+            assert!((a - b).norm() < 1e-12 * scale, "{a} vs {b}");
+        }
+        let power: Real = at(&stretch)
+            .iter()
+            .zip(&still)
+            .zip(&stretch)
+            .map(|((a, b), v)| (a - b).dot(v))
+            .sum();
+        assert!(power < 0.0, "damping power {power} W");
+    }
 
     /// The rotation of an overflowing or underflowing deformation gradient returns, finite
     /// (the SVD fallback is bounded): moved here from the robustness tests when `elastic`

@@ -35,6 +35,7 @@ pub(crate) mod elastic;
 pub(crate) mod error;
 pub mod ffi;
 pub mod grasp;
+pub(crate) mod lanes;
 pub(crate) mod math;
 pub mod mesh;
 pub mod needle;
@@ -46,6 +47,7 @@ pub(crate) mod solver;
 pub(crate) mod stability;
 pub mod state;
 pub mod statics;
+pub(crate) mod vec3_array;
 pub(crate) mod world;
 pub(crate) mod world_state;
 

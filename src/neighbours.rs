@@ -8,6 +8,7 @@
 //! `d_ij = w_ij A_i⁻¹ u_ij`, stored per pair.
 
 use crate::math::{Mat3, Real, Vec3};
+use crate::vec3_array::Vec3Array;
 
 /// Largest accepted condition number of a particle's moment matrix `A_i`; a particle above it
 /// gets a larger support radius (more neighbours) at load time.
@@ -28,10 +29,10 @@ pub struct Neighbourhoods {
     pub offsets: Vec<u32>,
     /// Neighbour index `j` of each pair.
     pub index: Vec<u32>,
-    /// Rest offset `u_ij = X_j - X_i` of each pair (m).
-    pub rest_offset: Vec<Vec3>,
-    /// MLS gradient vector `d_ij = w_ij A_i⁻¹ u_ij` of each pair (1/m).
-    pub gradient: Vec<Vec3>,
+    /// Rest offset `u_ij = X_j - X_i` of each pair (m), by component.
+    pub rest_offset: Vec3Array,
+    /// MLS gradient vector `d_ij = w_ij A_i⁻¹ u_ij` of each pair (1/m), by component.
+    pub gradient: Vec3Array,
     /// Kernel weight of each pair normalised over the particle's neighbourhood (which sums to
     /// 1), divided by the squared rest distance: `ŵ_ij / |u_ij|²` (1/m²), the geometric factor
     /// of the hourglass-control stiffness.
@@ -92,8 +93,8 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
     let mut out = Neighbourhoods {
         offsets: Vec::with_capacity(n + 1),
         index: Vec::new(),
-        rest_offset: Vec::new(),
-        gradient: Vec::new(),
+        rest_offset: Vec3Array::default(),
+        gradient: Vec3Array::default(),
         hourglass_weight: Vec::new(),
         support_radius: Vec::with_capacity(n),
         incoming_offsets: Vec::new(),

@@ -121,8 +121,8 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         let range = nbr.range(i);
         // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
         c.clear();
-        c.push(-nbr.gradient[range.clone()].iter().sum::<Vec3>());
-        c.extend_from_slice(&nbr.gradient[range.clone()]);
+        c.push(-nbr.gradient.iter_range(range.clone()).sum::<Vec3>());
+        c.extend(nbr.gradient.iter_range(range.clone()));
         // Linear elasticity: K_kl = v_i [μ (c_k·c_l) I + μ c_l c_kᵀ + λ c_k c_lᵀ].
         for (p, ck) in c.iter().enumerate() {
             for (q, cl) in c.iter().enumerate() {
@@ -135,7 +135,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         // Hourglass: ½ c_ij |ε_ij|², ε_ij = Σ_k a_k x_k with a_k = c_k·u_ij − δ_kj + δ_ki.
         if hourglass != 0.0 {
             for (slot, e) in range.enumerate() {
-                let u = nbr.rest_offset[e];
+                let u = nbr.rest_offset.get(e);
                 let cij = hourglass * vi * nbr.hourglass_weight[e];
                 a.clear();
                 a.extend(c.iter().map(|ck| ck.dot(&u)));

@@ -44,7 +44,7 @@ pub fn audit(body: &Body, u: &[Vec3]) -> Audit {
         // ∇u_i = Σ_j (u_j − u_i) g_ijᵀ, as the step's F.
         let g = nbr
             .range(i)
-            .map(|p| (u[nbr.index[p] as usize] - u[i]) * nbr.gradient[p].transpose())
+            .map(|p| (u[nbr.index[p] as usize] - u[i]) * nbr.gradient.get(p).transpose())
             .sum::<Mat3>();
         let volume = body.masses()[i] / body.material().density;
         e.particles = volume * deviatoric_density(mu, &g);

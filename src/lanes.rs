@@ -1,0 +1,249 @@
+//! Four `f64` lanes for the force pass's inner loops, on `wide::f64x4`: one AVX register in a
+//! build for x86-64-v3 (this repository's default, `.cargo/config.toml`), two SSE2 registers on
+//! baseline x86-64, two NEON registers on aarch64, plain arrays elsewhere.
+//!
+//! Every operation is lane-wise IEEE arithmetic: no fused multiply–add and no reassociation, so
+//! every build gives the same bits. Only [`F4::sum`] crosses lanes, in a fixed order.
+
+use crate::math::{Mat3, Real, Vec3};
+use crate::vec3_array::Vec3Slices;
+use std::ops::{Add, AddAssign, Mul, Sub};
+use wide::f64x4;
+
+/// Lane count.
+pub(crate) const LANES: usize = 4;
+
+/// Four lanes of [`Real`] (any unit).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct F4(f64x4);
+
+impl F4 {
+    /// All lanes `v`.
+    #[inline(always)]
+    pub(crate) fn splat(v: Real) -> F4 {
+        F4(f64x4::splat(v))
+    }
+    /// The lanes `a`.
+    #[inline(always)]
+    pub(crate) fn new(a: [Real; LANES]) -> F4 {
+        F4(f64x4::new(a))
+    }
+    /// The lanes as an array.
+    #[inline(always)]
+    pub(crate) fn to_array(self) -> [Real; LANES] {
+        self.0.to_array()
+    }
+    /// `s[start..start + 4]`, lanes past the end of `s` zero.
+    #[inline(always)]
+    pub(crate) fn load(s: &[Real], start: usize) -> F4 {
+        match s.get(start..start + LANES) {
+            Some(c) => F4::new([c[0], c[1], c[2], c[3]]),
+            None => {
+                let mut out = [0.0; LANES];
+                for (o, v) in out.iter_mut().zip(&s[start..]) {
+                    *o = *v;
+                }
+                F4::new(out)
+            }
+        }
+    }
+    /// Lane `l` is `f(l)`: lane-wise selections.
+    #[inline(always)]
+    pub(crate) fn from_fn(f: impl FnMut(usize) -> Real) -> F4 {
+        F4::new(std::array::from_fn(f))
+    }
+    /// `(l0 + l1) + (l2 + l3)`.
+    #[inline(always)]
+    pub(crate) fn sum(self) -> Real {
+        let [a, b, c, d] = self.to_array();
+        (a + b) + (c + d)
+    }
+}
+
+impl Add for F4 {
+    type Output = F4;
+    #[inline(always)]
+    fn add(self, o: F4) -> F4 {
+        F4(self.0 + o.0)
+    }
+}
+
+impl Sub for F4 {
+    type Output = F4;
+    #[inline(always)]
+    fn sub(self, o: F4) -> F4 {
+        F4(self.0 - o.0)
+    }
+}
+
+impl Mul for F4 {
+    type Output = F4;
+    #[inline(always)]
+    fn mul(self, o: F4) -> F4 {
+        F4(self.0 * o.0)
+    }
+}
+
+impl AddAssign for F4 {
+    #[inline(always)]
+    fn add_assign(&mut self, o: F4) {
+        *self = *self + o;
+    }
+}
+
+/// Four 3-vectors (any unit), one lane each: `(x[l], y[l], z[l])` is vector `l`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct V4 {
+    pub(crate) x: F4,
+    pub(crate) y: F4,
+    pub(crate) z: F4,
+}
+
+impl V4 {
+    /// All lanes `v`.
+    #[inline(always)]
+    pub(crate) fn splat(v: &Vec3) -> V4 {
+        V4 {
+            x: F4::splat(v.x),
+            y: F4::splat(v.y),
+            z: F4::splat(v.z),
+        }
+    }
+    /// Vectors `start..start + 4` of `a`, lanes past its end zero.
+    #[inline(always)]
+    pub(crate) fn load(a: &Vec3Slices<'_>, start: usize) -> V4 {
+        V4 {
+            x: F4::load(a.x, start),
+            y: F4::load(a.y, start),
+            z: F4::load(a.z, start),
+        }
+    }
+    /// `field[j[l]]` in lane `l`.
+    #[inline(always)]
+    pub(crate) fn gather(field: &[Vec3], j: &[usize; LANES]) -> V4 {
+        let (a, b, c, d) = (&field[j[0]], &field[j[1]], &field[j[2]], &field[j[3]]);
+        V4 {
+            x: F4::new([a.x, b.x, c.x, d.x]),
+            y: F4::new([a.y, b.y, c.y, d.y]),
+            z: F4::new([a.z, b.z, c.z, d.z]),
+        }
+    }
+    /// Lane-wise dot product.
+    #[inline(always)]
+    pub(crate) fn dot(&self, o: &V4) -> F4 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// Every lane scaled by the lane's `s`.
+    #[inline(always)]
+    pub(crate) fn scale(&self, s: F4) -> V4 {
+        V4 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+    /// Write vector `l` to `out[l]` for every `l < out.len()` (at most 4).
+    #[inline(always)]
+    pub(crate) fn store(&self, out: &mut [Vec3]) {
+        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = Vec3::new(x[l], y[l], z[l]);
+        }
+    }
+    /// The sum of the four vectors.
+    #[inline(always)]
+    pub(crate) fn sum(&self) -> Vec3 {
+        Vec3::new(self.x.sum(), self.y.sum(), self.z.sum())
+    }
+}
+
+impl Add for V4 {
+    type Output = V4;
+    #[inline(always)]
+    fn add(self, o: V4) -> V4 {
+        V4 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl Sub for V4 {
+    type Output = V4;
+    #[inline(always)]
+    fn sub(self, o: V4) -> V4 {
+        V4 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl AddAssign for V4 {
+    #[inline(always)]
+    fn add_assign(&mut self, o: V4) {
+        *self = *self + o;
+    }
+}
+
+/// Four 3×3 matrices (any unit), one lane each, by rows.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct M4 {
+    pub(crate) rows: [V4; 3],
+}
+
+impl M4 {
+    /// All lanes `m`.
+    #[inline(always)]
+    pub(crate) fn splat(m: &Mat3) -> M4 {
+        M4 {
+            rows: [0, 1, 2].map(|r| V4 {
+                x: F4::splat(m[(r, 0)]),
+                y: F4::splat(m[(r, 1)]),
+                z: F4::splat(m[(r, 2)]),
+            }),
+        }
+    }
+    /// Lane-wise `self += a bᵀ`.
+    #[inline(always)]
+    pub(crate) fn add_outer(&mut self, a: &V4, b: &V4) {
+        let [r0, r1, r2] = &mut self.rows;
+        *r0 += b.scale(a.x);
+        *r1 += b.scale(a.y);
+        *r2 += b.scale(a.z);
+    }
+    /// Lane-wise `self v`.
+    #[inline(always)]
+    pub(crate) fn mul(&self, v: &V4) -> V4 {
+        let [r0, r1, r2] = &self.rows;
+        V4 {
+            x: r0.dot(v),
+            y: r1.dot(v),
+            z: r2.dot(v),
+        }
+    }
+    /// The sum of the four matrices.
+    #[inline(always)]
+    pub(crate) fn sum(&self) -> Mat3 {
+        let [r0, r1, r2] = self.rows.map(|r| r.sum());
+        Mat3::from_rows(&[r0.transpose(), r1.transpose(), r2.transpose()])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_load_past_the_end_fills_zeros_and_sums_in_order() {
+        let s = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        assert_eq!(F4::load(&s, 1), F4::new([2.0, 3.0, 4.0, 5.0]));
+        assert_eq!(F4::load(&s, 4), F4::new([5.0, 6.0, 0.0, 0.0]));
+        let a = F4::new([1e16, 1.0, -1e16, 1.0]);
+        // (1e16 + 1) + (-1e16 + 1) = 1e16 + (-1e16 + 1) rounding: 0 exactly in this order.
+        assert_eq!(a.sum(), (1e16 + 1.0) + (-1e16 + 1.0));
+        assert_eq!(a * F4::splat(2.0) - a + F4::default(), a);
+    }
+}
