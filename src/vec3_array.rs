@@ -18,14 +18,6 @@ pub struct Vec3Array {
 }
 
 impl Vec3Array {
-    /// Number of vectors.
-    pub fn len(&self) -> usize {
-        self.x.len()
-    }
-    /// True when there are no vectors.
-    pub fn is_empty(&self) -> bool {
-        self.x.is_empty()
-    }
     /// Vector `e`.
     #[inline]
     pub fn get(&self, e: usize) -> Vec3 {
@@ -80,16 +72,6 @@ pub struct Vec3Slices<'a> {
     pub z: &'a [Real],
 }
 
-impl FromIterator<Vec3> for Vec3Array {
-    fn from_iter<I: IntoIterator<Item = Vec3>>(iter: I) -> Self {
-        let mut out = Vec3Array::default();
-        for v in iter {
-            out.push(v);
-        }
-        out
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,8 +79,8 @@ mod tests {
     #[test]
     fn vectors_round_trip_through_the_components() {
         let vs = [Vec3::new(1.0, 2.0, 3.0), Vec3::new(-4.0, 5.5, 0.0)];
-        let mut a: Vec3Array = vs.iter().copied().collect();
-        assert_eq!(a.len(), 2);
+        let mut a = Vec3Array::default();
+        vs.iter().for_each(|v| a.push(*v));
         assert_eq!(a.get(1), vs[1]);
         a.set(0, Vec3::new(7.0, 8.0, 9.0));
         assert_eq!(a.x, vec![7.0, -4.0]);
