@@ -135,16 +135,16 @@ impl<'a> Operator<'a> {
         let mut diagonal = vec![0.0; n];
         for (i, vi) in volume.iter().enumerate() {
             let range = nbr.range(i);
-            let u: Vec<Vec3> = nbr.rest_offset.iter_range(range).collect();
-            let gram: Mat3 = u.iter().map(|u| u * u.transpose()).sum();
+            let u = || nbr.rest_offset.iter_range(range.clone());
+            let gram: Mat3 = u().map(|u| u * u.transpose()).sum();
             // The neighbourhood builder guarantees a well-conditioned moment matrix, hence
             // three independent offsets and an invertible Gram matrix.
             let ginv = gram.try_inverse().unwrap_or_else(Mat3::zeros);
             let w = vi * vi;
             // Π_jj = 1 − u_jᵀ G⁻¹ u_j; 1ᵀ Π 1 = k − sᵀ G⁻¹ s with s = Σ_j u_j.
-            let s: Vec3 = u.iter().sum();
-            diagonal[i] += w * (u.len() as Real - s.dot(&(ginv * s)));
-            for (e, uj) in nbr.range(i).zip(&u) {
+            let s: Vec3 = u().sum();
+            diagonal[i] += w * (range.len() as Real - s.dot(&(ginv * s)));
+            for (e, uj) in range.clone().zip(u()) {
                 diagonal[nbr.index[e] as usize] += w * (1.0 - uj.dot(&(ginv * uj)));
             }
             gram_inverse.push(ginv);
