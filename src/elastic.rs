@@ -531,15 +531,16 @@ mod tests {
             forces(&damped, &input, 1)
         };
         let still = at(&zero);
+        let stretched = at(&stretch);
         let scale = still
             .iter()
-            .chain(&at(&stretch))
+            .chain(&stretched)
             .map(|g| g.norm())
             .fold(1e-300, Real::max);
         for (a, b) in at(&rigid).iter().zip(&still) {
             assert!((a - b).norm() < 1e-12 * scale, "{a} vs {b}");
         }
-        let power: Real = at(&stretch)
+        let power: Real = stretched
             .iter()
             .zip(&still)
             .zip(&stretch)
