@@ -11,6 +11,7 @@
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 
 use crate::body::BodyOptions;
+use crate::colouring::TetColouring;
 use crate::consistency;
 use crate::error::Error;
 use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
@@ -43,6 +44,8 @@ pub struct BodyModel {
     pub(crate) size: Real,
     /// Rest volume (m³).
     pub(crate) rest_volume: Real,
+    /// The tetrahedra grouped into colours that share no particle, for the volume pass.
+    pub(crate) tet_colouring: TetColouring,
 }
 
 impl BodyModel {
@@ -111,6 +114,7 @@ impl BodyModel {
                 .unwrap_or_else(|| 0.5 * mesh.mean_edge_length()),
             rest_centre: (lo + hi) * 0.5,
             size: (hi - lo).norm(),
+            tet_colouring: TetColouring::new(&mesh.tets, n),
         }))
     }
 
@@ -153,5 +157,7 @@ impl BodyModel {
             + size_of_val(n.support_radius.as_slice())
             + size_of_val(n.incoming_offsets.as_slice())
             + size_of_val(n.incoming.as_slice())
+            + size_of_val(self.tet_colouring.blocks.as_slice())
+            + size_of_val(self.tet_colouring.starts.as_slice())
     }
 }

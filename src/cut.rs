@@ -23,6 +23,7 @@
 
 use crate::body::Body;
 use crate::body_model::BodyModel;
+use crate::colouring::TetColouring;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::Neighbourhoods;
@@ -234,6 +235,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
         }
     }
     model.rest_volume = model.tet_rest_volume.iter().sum();
+    model.tet_colouring = TetColouring::new(&model.tets, n);
     let mesh = TetMesh {
         nodes: model.rest.clone(),
         tets: model.tets.clone(),

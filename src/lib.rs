@@ -27,6 +27,7 @@
 pub(crate) mod body;
 pub(crate) mod body_model;
 pub(crate) mod collision;
+pub(crate) mod colouring;
 pub(crate) mod consistency;
 pub(crate) mod constraints;
 pub mod cut;

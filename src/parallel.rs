@@ -194,6 +194,73 @@ impl<T> SharedSlice<T> {
         // SAFETY: in bounds (checked) and exclusive by the caller's contract.
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
     }
+    /// Element `i`, mutable.
+    ///
+    /// # Safety
+    /// No other share may access element `i` during the job.
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn element(&self, i: usize) -> &mut T {
+        assert!(i < self.len);
+        // SAFETY: in bounds (checked) and exclusive by the caller's contract.
+        unsafe { &mut *self.ptr.add(i) }
+    }
+}
+
+/// A barrier for the shares of one `Pool::run` job that run in phases (a phase's writes are
+/// seen by every share after the barrier). If a share panics, [`Barrier::guard`] breaks the
+/// barrier so that the other shares do not wait for it forever.
+pub struct Barrier {
+    threads: usize,
+    arrived: AtomicUsize,
+    generation: AtomicUsize,
+    broken: AtomicBool,
+}
+
+impl Barrier {
+    /// A barrier for `threads` shares.
+    pub fn new(threads: usize) -> Barrier {
+        Barrier {
+            threads,
+            arrived: AtomicUsize::new(0),
+            generation: AtomicUsize::new(0),
+            broken: AtomicBool::new(false),
+        }
+    }
+    /// Wait until every share has arrived (or the barrier is broken).
+    pub fn wait(&self) {
+        let generation = self.generation.load(Ordering::Acquire);
+        if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.threads {
+            self.arrived.store(0, Ordering::Relaxed);
+            self.generation.fetch_add(1, Ordering::AcqRel);
+            return;
+        }
+        let mut spins = 0;
+        while self.generation.load(Ordering::Acquire) == generation
+            && !self.broken.load(Ordering::Acquire)
+        {
+            if spins < SPINS {
+                std::hint::spin_loop();
+                spins += 1;
+            } else {
+                thread::yield_now();
+            }
+        }
+    }
+    /// Held by a share for the length of its work: breaks the barrier if the share panics.
+    pub fn guard(&self) -> BarrierGuard<'_> {
+        BarrierGuard(self)
+    }
+}
+
+/// See [`Barrier::guard`].
+pub struct BarrierGuard<'a>(&'a Barrier);
+
+impl Drop for BarrierGuard<'_> {
+    fn drop(&mut self) {
+        if thread::panicking() {
+            self.0.broken.store(true, Ordering::Release);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -218,6 +285,40 @@ mod tests {
             let expected: Vec<u64> = (0..1000).map(|i| i * (0..50).sum::<u64>()).collect();
             assert_eq!(data, expected, "{threads} threads");
         }
+    }
+
+    #[test]
+    fn a_barrier_orders_the_phases_and_a_panic_breaks_it() {
+        let pool = Pool::new(2);
+        let mut data = vec![0u64; 100];
+        let barrier = Barrier::new(pool.threads());
+        let out = SharedSlice::new(&mut data);
+        pool.run(&|k| {
+            let _guard = barrier.guard();
+            for phase in 0..20u64 {
+                // Each phase reads what the other share wrote in the previous one.
+                let i = (k + phase as usize) % 2;
+                // SAFETY: in a phase, share k touches only the elements of parity i, the
+                // other share those of the other parity.
+                for e in (i..100).step_by(2) {
+                    let v = unsafe { out.element(e) };
+                    *v = *v * 2 + 1;
+                }
+                barrier.wait();
+            }
+        });
+        assert!(data.iter().all(|&v| v == (1 << 20) - 1), "{data:?}");
+        let barrier = Barrier::new(pool.threads());
+        let r = catch_unwind(AssertUnwindSafe(|| {
+            pool.run(&|k| {
+                let _guard = barrier.guard();
+                if k == 1 {
+                    panic!("boom");
+                }
+                barrier.wait();
+            })
+        }));
+        assert!(r.is_err(), "the panic reaches the caller, nobody hangs");
     }
 
     #[test]

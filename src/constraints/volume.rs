@@ -2,34 +2,31 @@
 
 use crate::math::{Real, Vec3};
 
-/// Project one tetrahedron's volume constraint.
+/// The projection of one tetrahedron's volume constraint.
 ///
-/// * `p` — predicted positions (m), updated in place for the four nodes `tet`;
-/// * `w` — inverse masses (1/kg; 0 for fixed particles);
+/// * `p` — predicted positions (m) of its four particles;
+/// * `w` — their inverse masses (1/kg; 0 for fixed particles);
 /// * `rest_volume` — `V0` (m³);
 /// * `alpha_tilde` — compliance divided by the squared substep, `α / h²` (m³/Pa / s² · …);
 ///   0 makes the constraint hard;
 /// * `lambda` — the constraint's accumulated multiplier within this substep, updated.
 ///
-/// Returns the constraint value `C` (m³) before the projection.
+/// Returns the constraint value `C` (m³) before the projection and the four position
+/// corrections (m; `None` when no particle can move).
 #[inline]
-pub fn project_volume_tet(
-    p: &mut [Vec3],
-    w: &[Real],
-    tet: [u32; 4],
+pub fn volume_tet_correction(
+    [pa, pb, pc, pd]: [Vec3; 4],
+    [wa, wb, wc, wd]: [Real; 4],
     rest_volume: Real,
     alpha_tilde: Real,
     lambda: &mut Real,
-) -> Real {
-    let [a, b, c, d] = tet.map(|k| k as usize);
-    let pa = p[a];
-    let (e1, e2, e3) = (p[b] - pa, p[c] - pa, p[d] - pa);
+) -> (Real, Option<[Vec3; 4]>) {
+    let (e1, e2, e3) = (pb - pa, pc - pa, pd - pa);
     // ∂V/∂p_b etc.; V = e1 · (e2 × e3) / 6 = e1 · g1.
     let g1 = e2.cross(&e3) * (1.0 / 6.0);
     let g2 = e3.cross(&e1) * (1.0 / 6.0);
     let g3 = e1.cross(&e2) * (1.0 / 6.0);
     let g0 = -(g1 + g2 + g3);
-    let (wa, wb, wc, wd) = (w[a], w[b], w[c], w[d]);
     let denom = wa * g0.norm_squared()
         + wb * g1.norm_squared()
         + wc * g2.norm_squared()
@@ -37,15 +34,17 @@ pub fn project_volume_tet(
         + alpha_tilde;
     let c_value = e1.dot(&g1) - rest_volume;
     if denom <= Real::MIN_POSITIVE {
-        return c_value;
+        return (c_value, None);
     }
     let dl = (-c_value - alpha_tilde * *lambda) / denom;
     *lambda += dl;
-    p[a] += g0 * (wa * dl);
-    p[b] += g1 * (wb * dl);
-    p[c] += g2 * (wc * dl);
-    p[d] += g3 * (wd * dl);
-    c_value
+    let dp = [
+        g0 * (wa * dl),
+        g1 * (wb * dl),
+        g2 * (wc * dl),
+        g3 * (wd * dl),
+    ];
+    (c_value, Some(dp))
 }
 
 #[cfg(test)]
@@ -55,7 +54,7 @@ mod tests {
 
     #[test]
     fn hard_constraint_restores_volume_of_a_single_tet() {
-        let mut p = vec![
+        let mut p = [
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(1.0, 0.0, 0.0),
             Vec3::new(0.0, 1.0, 0.0),
@@ -65,7 +64,9 @@ mod tests {
         let v0 = 1.0 / 6.0;
         let mut lambda = 0.0;
         for _ in 0..20 {
-            project_volume_tet(&mut p, &w, [0, 1, 2, 3], v0, 0.0, &mut lambda);
+            if let (_, Some(dp)) = volume_tet_correction(p, w, v0, 0.0, &mut lambda) {
+                p.iter_mut().zip(dp).for_each(|(x, d)| *x += d);
+            }
         }
         let v = tet_volume(&p[0], &p[1], &p[2], &p[3]);
         assert!((v - v0).abs() < 1e-12 * v0, "{v} vs {v0}");

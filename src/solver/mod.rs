@@ -184,7 +184,7 @@ impl World {
         for it in 0..self.settings.iterations {
             if self.settings.volume_constraints {
                 for (body, scratch) in self.bodies.iter().zip(scratch.iter_mut()) {
-                    volume::project_volumes(body, scratch, h);
+                    volume::project_volumes(body, scratch, h, &self.pool);
                 }
             }
             if organ_contact {
