@@ -79,6 +79,12 @@ impl Pool {
         (share * n / t)..((share + 1) * n / t)
     }
 
+    /// Run `job(range)` for each share's contiguous range of `0..n` (see [`Pool::share`]), on
+    /// every thread; with one thread, `job(0..n)` on the caller's.
+    pub fn for_each_range(&self, n: usize, job: &(dyn Fn(Range<usize>) + Sync)) {
+        self.run(&|share| job(self.share(share, n)));
+    }
+
     /// Run `job(k)` for every share `k` in `0..threads()` (share 0 on the calling thread) and
     /// return when all have finished. A panic in any share is re-raised here.
     pub fn run<'a>(&self, job: &'a (dyn Fn(usize) + Sync + 'a)) {

@@ -43,6 +43,7 @@ use crate::cut::{Blade, CutReport};
 use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
+use crate::parallel::SharedSlice;
 use crate::settings::ContactMode;
 use crate::world::{StepReport, World};
 use parry3d_f64::math::{Isometry, Point};
@@ -254,10 +255,22 @@ impl World {
         }
         let inv_h = 1.0 / h;
         for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter()) {
-            for i in 0..body.state.x.len() {
-                body.state.v[i] = (scratch.p[i] - body.state.x[i]) * inv_h;
-                body.state.x[i] = scratch.p[i];
-            }
+            let n = body.state.x.len();
+            let predicted = &scratch.p;
+            let state = &mut body.state;
+            let (position, velocity) = (
+                SharedSlice::new(&mut state.x),
+                SharedSlice::new(&mut state.v),
+            );
+            self.pool.for_each_range(n, &|range| {
+                // SAFETY: the shares' ranges are disjoint.
+                let (x, v) =
+                    unsafe { (position.range(range.clone()), velocity.range(range.clone())) };
+                for ((p, x), v) in predicted[range].iter().zip(x).zip(v) {
+                    *v = (p - *x) * inv_h;
+                    *x = *p;
+                }
+            });
         }
     }
 }

@@ -3,7 +3,7 @@
 use crate::body::{Body, ROTATION_ITERATIONS};
 use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::math::{Real, Vec3};
-use crate::parallel::Pool;
+use crate::parallel::{Pool, SharedSlice};
 use crate::solver::StepScratch;
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s): velocities into
@@ -35,15 +35,30 @@ pub(crate) fn predict(
         &mut scratch.force,
         pool,
     );
-    for i in 0..body.state.x.len() {
-        let w = body.inv_mass[i];
-        if body.fixed[i] {
-            body.state.v[i] = Vec3::zeros();
-            scratch.p[i] = body.state.x[i];
-        } else {
-            body.state.v[i] = body.state.v[i] * damping_factor + scratch.force[i] * (h * w);
-            scratch.p[i] = body.state.x[i] + body.state.v[i] * h;
+    let n = body.state.x.len();
+    let state = &mut body.state;
+    let (x, force, inv_mass, fixed) = (&state.x, &scratch.force, &body.inv_mass, &body.fixed);
+    let (velocity, predicted) = (
+        SharedSlice::new(&mut state.v),
+        SharedSlice::new(&mut scratch.p),
+    );
+    pool.for_each_range(n, &|range| {
+        // SAFETY: the shares' ranges are disjoint.
+        let (v, p) = unsafe {
+            (
+                velocity.range(range.clone()),
+                predicted.range(range.clone()),
+            )
+        };
+        for ((i, v), p) in range.zip(v).zip(p) {
+            if fixed[i] {
+                *v = Vec3::zeros();
+                *p = x[i];
+            } else {
+                *v = *v * damping_factor + force[i] * (h * inv_mass[i]);
+                *p = x[i] + *v * h;
+            }
         }
-    }
+    });
     scratch.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
 }
