@@ -216,9 +216,9 @@ typedef struct ts_settings {
      */
     uint8_t volumetric_split;
     /**
-     * Threads the point-based force computation runs on (1..=64; default 1): the calling
-     * thread plus threads - 1 workers owned by the world. Results are bit-identical for any
-     * count.
+     * Threads a step runs on (1..=64; default 1): the calling thread plus threads - 1
+     * workers owned by the world, sharing the force, volume, prediction and update passes.
+     * Results are bit-identical for any count.
      */
     uint32_t threads;
     /**

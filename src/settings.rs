@@ -92,8 +92,9 @@ pub struct Settings {
     pub max_depenetration_speed: Real,
     /// Enable contact between particles of the same body (off by default).
     pub self_contact: bool,
-    /// Threads the point-based force computation runs on (≥ 1): the calling thread plus
-    /// `threads - 1` workers owned by the world. Results are bit-identical for any count.
+    /// Threads a step runs on (≥ 1): the calling thread plus `threads - 1` workers owned by
+    /// the world, sharing the force, volume, prediction and update passes (tool contacts stay
+    /// on the calling thread). Results are bit-identical for any count.
     /// Default 1: a haptic loop usually owns one core; set 2 on a machine with a free core.
     pub threads: u32,
     /// Physical bounds checked after every step: a step that leaves them is rolled back and

@@ -145,7 +145,7 @@ crate::fmi2_variables! {
         GRAVITY_X = param("gravity_x", Tunable, "m/s2", 0.0, None, "Gravity acceleration x"),
         GRAVITY_Y = param("gravity_y", Tunable, "m/s2", -9.81, None, "Gravity acceleration y"),
         GRAVITY_Z = param("gravity_z", Tunable, "m/s2", 0.0, None, "Gravity acceleration z"),
-        THREADS = Variable::integer("threads", Parameter, Fixed, Some(1), Some(1), Some(64), "Threads of the elastic force pass (the calling thread plus threads - 1 workers); results are bit-identical for any count"),
+        THREADS = Variable::integer("threads", Parameter, Fixed, Some(1), Some(1), Some(64), "Threads of a step (the calling thread plus threads - 1 workers, sharing the force, volume, prediction and update passes); results are bit-identical for any count"),
         SETTLE = Variable::boolean("settle", Parameter, Fixed, false, "Start at rest: at fmi2ExitInitializationMode the organ is brought to its static equilibrium under gravity (World::settle: Newton static solve, then damped relaxation; velocities zero), so the co-simulation does not start with the organ swinging into place; an organ with no fixed node cannot settle (fmi2Error)"),
         GRASP = Variable::boolean("grasp", Input, Discrete, false, "Grasp: while true the tool holds the tissue within reach of its surface (compliant attachments; the pull shows in force_*); at each communication step a tool that holds nothing grasps what is within reach, and false releases"),
         GRASPED_COUNT = Variable::integer("grasped_count", Output, Discrete, None, Some(0), None, "Number of organ particles the tool holds at the end of the step (0 when not grasping)"),

@@ -65,9 +65,9 @@ pub struct ts_settings {
     /// constraints (compliance 1/lambda + volume_compliance) instead of the particles: 0 off,
     /// non-zero on (the default). Off gives the paper's literal arrangement.
     pub volumetric_split: u8,
-    /// Threads the point-based force computation runs on (1..=64; default 1): the calling
-    /// thread plus threads - 1 workers owned by the world. Results are bit-identical for any
-    /// count.
+    /// Threads a step runs on (1..=64; default 1): the calling thread plus threads - 1
+    /// workers owned by the world, sharing the force, volume, prediction and update passes.
+    /// Results are bit-identical for any count.
     pub threads: u32,
     /// Divergence check: largest particle speed, in body sizes per second (1/s, > 0; default
     /// 250, i.e. 50 m/s for a 0.2 m organ). A step beyond it is rolled back and returns
