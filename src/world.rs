@@ -509,8 +509,8 @@ impl World {
     /// stiffness, sparse direct factorisation, at most [`SETTLE_MAX_ITERATIONS`] per body; exact
     /// for moderate sags), then dynamic relaxation with the world's own step and kinetic
     /// damping (every particle stopped, half a substep back, whenever the kinetic energy
-    /// passes a peak) until no
-    /// particle moves faster than [`SETTLE_SPEED`] or [`SETTLE_MAX_STEPS`] steps. The second
+    /// passes a peak) until no particle moves faster than [`SETTLE_SPEED`] or
+    /// [`SETTLE_MAX_STEPS`] steps. The second
     /// stage ends in the equilibrium the step itself holds, tools included. Simulated time is
     /// not advanced and velocities end at zero.
     ///
@@ -532,8 +532,7 @@ impl World {
         }
         let before = std::mem::replace(&mut self.bodies, settled);
         let time = self.time;
-        let relaxed = self.relax(SETTLE_MAX_STEPS);
-        let (steps, speed) = match relaxed {
+        let (steps, speed) = match self.relax(SETTLE_MAX_STEPS, true) {
             Ok(r) => r,
             Err(e) => {
                 self.bodies = before;
@@ -551,27 +550,24 @@ impl World {
         })
     }
 
-    /// Dynamic relaxation from rest: steps with kinetic damping until no particle moves faster
-    /// than [`SETTLE_SPEED`](crate::statics::SETTLE_SPEED) (m/s) or `max_steps` steps; ends at
-    /// rest. Returns the steps taken and the last largest speed (m/s).
+    /// Dynamic relaxation: steps with kinetic damping until no particle moves faster than
+    /// [`SETTLE_SPEED`](crate::statics::SETTLE_SPEED) (m/s) or `max_steps` steps; ends at rest.
+    /// Returns the steps taken and the last largest speed (m/s).
     ///
     /// When the kinetic energy passes a peak, every particle goes back half its last substep
-    /// (`x ← x − h v / 2`) and stops. The half step matters: symplectic Euler's velocity belongs
-    /// half a substep behind its position, and a mode of frequency ω stopped without the
-    /// correction restarts with up to `1/√(1 − (ωh)²/4)` of its amplitude (2.3× at the
-    /// `ωh = 1.8` the default stability margin allows), so the stiffest modes grew under
-    /// repeated stops. With it, no mode with `ωh < 2` gains amplitude at a stop.
-    fn relax(&mut self, max_steps: u32) -> Result<(u32, Real), Error> {
-        self.relax_with(max_steps, true)
-    }
-
-    /// [`World::relax`], stopping the particles half a substep back (`back`) or where they are.
-    fn relax_with(&mut self, max_steps: u32, back: bool) -> Result<(u32, Real), Error> {
-        let at_rest = |w: &mut World, back: Real| {
+    /// (`x ← x − h v / 2`, settle's choice; `back = false` stops it where it is) and stops. The
+    /// half step matters: symplectic Euler's velocity belongs half a substep behind its
+    /// position, and a mode of frequency ω stopped where it is restarts with up to
+    /// `1/√(1 − (ωh)²/4)` of its amplitude (2.3× at the `ωh = 1.8` the default stability margin
+    /// allows), so the stiffest modes can grow under repeated stops. Stopped half a substep
+    /// back, no mode with `ωh < 2` gains amplitude.
+    fn relax(&mut self, max_steps: u32, back: bool) -> Result<(u32, Real), Error> {
+        // Stop every particle after moving it back by its velocity times `rewind` (s).
+        let at_rest = |w: &mut World, rewind: Real| {
             for b in &mut w.bodies {
                 let state = &mut b.state;
                 for (x, v) in state.x.iter_mut().zip(state.v.iter_mut()) {
-                    *x -= *v * back;
+                    *x -= *v * rewind;
                     *v = Vec3::zeros();
                 }
             }
@@ -650,7 +646,7 @@ mod tests {
             .collect();
         let v = vec![Vec3::zeros(); x.len()];
         world.set_body_state(id, &x, &v).unwrap();
-        world.relax_with(5000, back)
+        world.relax(5000, back)
     }
 
     #[test]
