@@ -11,8 +11,7 @@ use crate::math::{Real, Vec3};
 ///   0 makes the constraint hard;
 /// * `lambda` — the constraint's accumulated multiplier within this substep, updated.
 ///
-/// Returns the constraint value `C` (m³) before the projection and the four position
-/// corrections (m; `None` when no particle can move).
+/// Returns the four position corrections (m; `None` when no particle can move).
 #[inline]
 pub fn volume_tet_correction(
     [pa, pb, pc, pd]: [Vec3; 4],
@@ -20,7 +19,7 @@ pub fn volume_tet_correction(
     rest_volume: Real,
     alpha_tilde: Real,
     lambda: &mut Real,
-) -> (Real, Option<[Vec3; 4]>) {
+) -> Option<[Vec3; 4]> {
     let (e1, e2, e3) = (pb - pa, pc - pa, pd - pa);
     // ∂V/∂p_b etc.; V = e1 · (e2 × e3) / 6 = e1 · g1.
     let g1 = e2.cross(&e3) * (1.0 / 6.0);
@@ -34,7 +33,7 @@ pub fn volume_tet_correction(
         + alpha_tilde;
     let c_value = e1.dot(&g1) - rest_volume;
     if denom <= Real::MIN_POSITIVE {
-        return (c_value, None);
+        return None;
     }
     let dl = (-c_value - alpha_tilde * *lambda) / denom;
     *lambda += dl;
@@ -44,7 +43,7 @@ pub fn volume_tet_correction(
         g2 * (wc * dl),
         g3 * (wd * dl),
     ];
-    (c_value, Some(dp))
+    Some(dp)
 }
 
 #[cfg(test)]
@@ -64,7 +63,7 @@ mod tests {
         let v0 = 1.0 / 6.0;
         let mut lambda = 0.0;
         for _ in 0..20 {
-            if let (_, Some(dp)) = volume_tet_correction(p, w, v0, 0.0, &mut lambda) {
+            if let Some(dp) = volume_tet_correction(p, w, v0, 0.0, &mut lambda) {
                 p.iter_mut().zip(dp).for_each(|(x, d)| *x += d);
             }
         }

@@ -36,7 +36,7 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             let w = k.map(|k| body.inv_mass[k]);
             let lambda = unsafe { lambda.element(t) };
             let alpha = compliance_per_h2 * v0;
-            if let (_, Some(dp)) = volume_tet_correction(x, w, v0, alpha, lambda) {
+            if let Some(dp) = volume_tet_correction(x, w, v0, alpha, lambda) {
                 for (k, d) in k.into_iter().zip(dp) {
                     *unsafe { p.element(k) } += d;
                 }
