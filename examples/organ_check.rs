@@ -84,9 +84,10 @@ fn run(organ: &tissuesim::mesh::TetMesh, out: &Path, hourglass: f64) -> Res<()> 
     let (lo, hi) = organ.bounding_box();
     let threshold = hi.y - 0.1 * (hi.y - lo.y);
     let fixed: Vec<u32> = (0..organ.nodes.len() as u32)
-        .filter(|&i| organ.nodes[i as usize].y >= threshold)
+        .filter(|&k| organ.nodes[k as usize].y >= threshold)
         .collect();
-    world.fix_particles(id, &fixed)?;
+    let particles = world.body(id)?.particle_order().particles_of(&fixed);
+    world.fix_particles(id, &particles.ok_or("fixed node out of range")?)?;
     for _ in 0..8000 {
         world.step()?;
     }
@@ -99,9 +100,11 @@ fn run(organ: &tissuesim::mesh::TetMesh, out: &Path, hourglass: f64) -> Res<()> 
     );
     let mut f = std::fs::File::create(out)?;
     writeln!(f, "node,ux,uy,uz")?;
-    for (i, (p, r)) in b.positions().iter().zip(b.rest_positions()).enumerate() {
-        let u = p - r;
-        writeln!(f, "{i},{:.17e},{:.17e},{:.17e}", u.x, u.y, u.z)?;
+    let order = b.particle_order();
+    for k in 0..b.particle_count() {
+        let i = order.particle(k);
+        let u = b.positions()[i] - b.rest_positions()[i];
+        writeln!(f, "{k},{:.17e},{:.17e},{:.17e}", u.x, u.y, u.z)?;
     }
     Ok(())
 }

@@ -175,8 +175,9 @@ fn rel_l2(u: &[Vec3], ids: &[usize], reference: &HashMap<usize, Vec3>) -> Res<Re
 }
 
 /// The best-fit scale of `u` against the reference and the energy audit of the reference field.
-fn print_audit(body: &Body, u: &[Vec3], scene: &Scene, reference: &HashMap<usize, Vec3>) {
-    let r: Vec<Vec3> = scene.ids.iter().map(|k| reference[k]).collect();
+/// `ids`: the reference node id of each particle.
+fn print_audit(body: &Body, u: &[Vec3], ids: &[usize], reference: &HashMap<usize, Vec3>) {
+    let r: Vec<Vec3> = ids.iter().map(|k| reference[k]).collect();
     let dot = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(p, q)| p.dot(q)).sum::<Real>();
     let scale = dot(u, &r) / dot(&r, &r);
     let a = audit::audit(body, &r);
@@ -230,10 +231,16 @@ fn main() -> Res<()> {
             ..options.clone()
         };
         let id = world.add_body(&scene.mesh, &o)?;
-        world.fix_particles(id, &scene.fixed)?;
+        // The scene names mesh nodes; the body works in its particle order.
+        let order = world.body(id)?.particle_order().clone();
+        let fixed = order
+            .particles_of(&scene.fixed)
+            .ok_or("fixed node out of range")?;
+        world.fix_particles(id, &fixed)?;
+        let ids = order.to_particle_order(&scene.ids);
         let body = world.body(id)?;
         let u = statics::linear_gravity_sag(body, Vec3::new(0.0, -scene.g, 0.0))?;
-        let e = rel_l2(&u, &scene.ids, &reference)?;
+        let e = rel_l2(&u, &ids, &reference)?;
         let p1 = read_reference(&scene.p1)
             .ok()
             .and_then(|p1| {
@@ -244,7 +251,7 @@ fn main() -> Res<()> {
             .unwrap_or_else(|| "-".into());
         println!("{} | {:.1}% | {p1}", scene.name, 100.0 * e);
         if with_audit {
-            print_audit(body, &u, &scene, &reference);
+            print_audit(body, &u, &ids, &reference);
         }
     }
     Ok(())

@@ -18,6 +18,8 @@
  *    was being changed, the world is poisoned (TS_STATUS_POISONED from then on; free it).
  *  - Arrays are (pointer, length) pairs; lengths count elements of the pointed-to type (doubles,
  *    uint32_t or bytes), not bytes or vectors. Vector arrays are row-major N x 3 (x, y, z).
+ *  - Particle k of a body is node k of its mesh (after unreferenced nodes are removed, see
+ *    ts_body_source_indices): per-particle arrays and indices are in the mesh's node order.
  *  - Units are SI: m, kg, s, N, Pa. Quaternions are (w, x, y, z).
  *  - ts_world_step allocates no memory after the first step.
  *

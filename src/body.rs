@@ -1,6 +1,9 @@
 //! A deformable body in a world: its shared load-time model ([`BodyModel`]: rest data,
 //! neighbourhoods, masses), the elastic constants and mass scaling under the world's settings,
 //! the fixed particles and the particle state.
+//!
+//! A body stores its particles in particle order, the mesh's nodes sorted for memory locality
+//! ([`ParticleOrder`]); its Rust API speaks that order, the C ABI and the FMU the mesh's.
 
 use crate::body_model::BodyModel;
 use crate::elastic::{self, ElasticModel, ForceInputs};
@@ -8,6 +11,7 @@ use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
 use crate::neighbours::{self, Neighbourhoods};
 use crate::parallel::Pool;
+use crate::particle_order::ParticleOrder;
 use crate::settings::Settings;
 use std::sync::Arc;
 
@@ -333,6 +337,15 @@ impl Body {
     /// Number of particles (= mesh nodes).
     pub fn particle_count(&self) -> usize {
         self.state.x.len()
+    }
+    /// Which mesh node each particle is. The per-particle slices and indices of this API
+    /// (positions, velocities, masses, tetrahedra, fixed flags, [`World::fix_particles`])
+    /// are in particle order: the mesh's nodes sorted for memory locality at load time.
+    /// [`ParticleOrder::to_mesh_order`] gives any of them in the mesh's order.
+    ///
+    /// [`World::fix_particles`]: crate::World::fix_particles
+    pub fn particle_order(&self) -> &ParticleOrder {
+        &self.model.order
     }
     /// Current particle positions (m), one per particle.
     pub fn positions(&self) -> &[Vec3] {

@@ -17,6 +17,7 @@ use crate::error::Error;
 use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::particle_order::ParticleOrder;
 use std::sync::Arc;
 
 /// The load-time data of a body (see the module documentation).
@@ -46,6 +47,8 @@ pub struct BodyModel {
     pub(crate) rest_volume: Real,
     /// The tetrahedra grouped into colours that share no particle, for the volume pass.
     pub(crate) tet_colouring: TetColouring,
+    /// Which mesh node each particle is: every array above is in particle order.
+    pub(crate) order: ParticleOrder,
 }
 
 impl BodyModel {
@@ -66,12 +69,24 @@ impl BodyModel {
         if let Some(k) = mesh.nodes.iter().position(|p| !is_finite_vec(p)) {
             return Err(Error::NonFinite(format!("mesh node {k}")));
         }
+        if let Some(t) = mesh
+            .tets
+            .iter()
+            .position(|tet| tet.iter().any(|&k| k as usize >= n))
+        {
+            return bad(format!("tetrahedron {t} references a node out of range"));
+        }
+        // Everything below works in particle order; messages name mesh nodes.
+        let order = ParticleOrder::morton(&mesh.nodes);
+        let boundary: Vec<[u32; 3]> = mesh
+            .boundary_triangles()
+            .iter()
+            .map(|t| order.particles_of_array(t))
+            .collect();
+        let mesh = &order.renumber(mesh);
         let mut particle_volume = vec![0.0; n];
         let mut tet_rest_volume = Vec::with_capacity(mesh.tets.len());
         for (t, tet) in mesh.tets.iter().enumerate() {
-            if tet.iter().any(|&k| k as usize >= n) {
-                return bad(format!("tetrahedron {t} references a node out of range"));
-            }
             let [a, b, c, d] = tet.map(|k| mesh.nodes[k as usize]);
             let vol = tet_volume(&a, &b, &c, &d);
             if vol <= 0.0 {
@@ -82,7 +97,8 @@ impl BodyModel {
                 particle_volume[k as usize] += 0.25 * vol;
             }
         }
-        if let Some(k) = particle_volume.iter().position(|&v| v <= 0.0) {
+        if let Some(i) = particle_volume.iter().position(|&v| v <= 0.0) {
+            let k = order.mesh_index(i);
             return bad(format!("node {k} belongs to no tetrahedron"));
         }
         options.check_radii(mesh.mean_edge_length())?;
@@ -92,8 +108,12 @@ impl BodyModel {
                 target: options.target_neighbours as usize,
             },
         };
-        let mut nbr = neighbours::build(&mesh.nodes, support).map_err(Error::InvalidArgument)?;
-        let boundary = mesh.boundary_triangles();
+        let mut nbr = neighbours::build(&mesh.nodes, support).map_err(|e| {
+            Error::InvalidArgument(match e.particle {
+                Some(i) => format!("mesh node {}: {}", order.mesh_index(i), e.reason),
+                None => e.reason,
+            })
+        })?;
         if options.consistent_gradients {
             consistency::correct_gradients(&mut nbr, &mesh.nodes, &particle_volume, &boundary);
         }
@@ -115,6 +135,7 @@ impl BodyModel {
             rest_centre: (lo + hi) * 0.5,
             size: (hi - lo).norm(),
             tet_colouring: TetColouring::new(&mesh.tets, n),
+            order,
         }))
     }
 
@@ -126,9 +147,30 @@ impl BodyModel {
     pub fn options(&self) -> &BodyOptions {
         &self.options
     }
-    /// Rest positions (m), one per particle.
+    /// Rest positions (m), one per particle, in particle order.
     pub fn rest_positions(&self) -> &[Vec3] {
         &self.rest
+    }
+    /// Which mesh node each particle is (the model stores its particles in an order of its
+    /// own, see [`ParticleOrder`]).
+    pub fn particle_order(&self) -> &ParticleOrder {
+        &self.order
+    }
+    /// Whether this model was built from `mesh` (in the mesh's node order) and `options`.
+    pub fn is_built_from(&self, mesh: &TetMesh, options: &BodyOptions) -> bool {
+        self.options == *options
+            && self.rest.len() == mesh.nodes.len()
+            && self.tets.len() == mesh.tets.len()
+            && mesh
+                .nodes
+                .iter()
+                .enumerate()
+                .all(|(k, p)| self.rest[self.order.particle(k)] == *p)
+            && self
+                .tets
+                .iter()
+                .zip(&mesh.tets)
+                .all(|(t, m)| self.order.mesh_indices_of_array(t) == *m)
     }
     /// Tetrahedra (4 particle indices each).
     pub fn tets(&self) -> &[[u32; 4]] {
@@ -158,6 +200,42 @@ impl BodyModel {
             + size_of_val(n.incoming_offsets.as_slice())
             + size_of_val(n.incoming.as_slice())
             + size_of_val(self.tet_colouring.blocks.as_slice())
+            + 2 * size_of_val(self.order.mesh_indices())
             + size_of_val(self.tet_colouring.starts.as_slice())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::lattice_box;
+
+    /// The model keeps its particles in its own order, but every array agrees with the mesh
+    /// through that order, and an error names the mesh's node, not the particle.
+    #[test]
+    fn the_model_is_the_mesh_in_particle_order_and_errors_name_mesh_nodes() {
+        let mesh = lattice_box(Vec3::zeros(), Vec3::new(0.04, 0.03, 0.02), [4, 3, 2]);
+        let model = BodyModel::new(&mesh, &BodyOptions::default()).unwrap();
+        let order = model.particle_order();
+        assert!((0..order.len()).any(|i| order.mesh_index(i) != i));
+        assert!(model.is_built_from(&mesh, &BodyOptions::default()));
+        assert_eq!(order.to_mesh_order(model.rest_positions()), mesh.nodes);
+        for (t, m) in model.tets().iter().zip(&mesh.tets) {
+            assert_eq!(order.mesh_indices_of_array(t), *m);
+        }
+        for (b, m) in model.boundary.iter().zip(mesh.boundary_triangles()) {
+            assert_eq!(order.mesh_indices_of_array(b), m);
+        }
+        // A node in no tetrahedron, appended last but sorted into the middle.
+        let mut stray = mesh.clone();
+        stray.nodes.push(Vec3::new(0.021, 0.016, 0.011));
+        let k = stray.nodes.len() - 1;
+        let i = ParticleOrder::morton(&stray.nodes).particle(k);
+        assert_ne!(i, k);
+        let e = BodyModel::new(&stray, &BodyOptions::default()).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            Error::InvalidArgument(format!("node {k} belongs to no tetrahedron")).to_string()
+        );
     }
 }

@@ -80,14 +80,25 @@ pub enum SupportRadius {
     Fixed(Real),
 }
 
+/// Why [`build`] failed: at which particle (none for a set too small), and the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NeighbourhoodError {
+    /// The particle whose neighbourhood failed (an index into `rest`).
+    pub particle: Option<usize>,
+    /// What failed, and what to change.
+    pub reason: String,
+}
+
 /// Build the neighbourhoods of particles at rest positions `rest` (m).
 ///
-/// Fails (with a message) when a particle cannot get a well-conditioned moment matrix, i.e. the
-/// points around it are (nearly) coplanar even with [`MAX_NEIGHBOURS`] neighbours.
-pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, String> {
+/// Fails when a particle cannot get a well-conditioned moment matrix, i.e. the points around it
+/// are (nearly) coplanar even with [`MAX_NEIGHBOURS`] neighbours, or when a fixed support
+/// radius holds too many or too few of them.
+pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, NeighbourhoodError> {
     let n = rest.len();
+    let fail = |particle, reason| Err(NeighbourhoodError { particle, reason });
     if n < 5 {
-        return Err(format!("a body needs at least 5 particles, got {n}"));
+        return fail(None, format!("a body needs at least 5 particles, got {n}"));
     }
     let grid = PointGrid::new(rest);
     let mut out = Neighbourhoods {
@@ -108,16 +119,22 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
                 grid.within(rest, i, h, &mut candidates);
                 let c = candidates.len();
                 if c > MAX_FIXED_NEIGHBOURS {
-                    return Err(format!(
-                        "particle {i}: support_radius {h} m holds {c} neighbours, more than \
-                         {MAX_FIXED_NEIGHBOURS}; use a smaller radius"
-                    ));
+                    return fail(
+                        Some(i),
+                        format!(
+                            "support_radius {h} m holds {c} neighbours, more than \
+                             {MAX_FIXED_NEIGHBOURS}; use a smaller radius"
+                        ),
+                    );
                 }
                 if moment_condition(rest, i, &candidates[..c], h) > MAX_MOMENT_CONDITION {
-                    return Err(format!(
-                        "particle {i}: support radius {h} m gives an ill-conditioned moment \
-                         matrix ({c} neighbours); use a larger radius"
-                    ));
+                    return fail(
+                        Some(i),
+                        format!(
+                            "support radius {h} m gives an ill-conditioned moment matrix ({c} \
+                             neighbours); use a larger radius"
+                        ),
+                    );
                 }
                 (h, c)
             }
@@ -137,11 +154,14 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
                         break (h, inside);
                     }
                     if k >= MAX_NEIGHBOURS.min(n - 1) {
-                        return Err(format!(
-                            "particle {i}: no well-conditioned neighbourhood with up to {k} \
-                             neighbours (condition {cond:.3e}); the points around it are \
-                             nearly coplanar"
-                        ));
+                        return fail(
+                            Some(i),
+                            format!(
+                                "no well-conditioned neighbourhood with up to {k} neighbours \
+                                 (condition {cond:.3e}); the points around it are nearly \
+                                 coplanar"
+                            ),
+                        );
                     }
                     k = (k + k / 4 + 1).min(MAX_NEIGHBOURS).min(n - 1);
                 }
@@ -149,9 +169,10 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, St
         };
         let pairs = &candidates[..count];
         let a = moment_matrix(rest, i, pairs, h);
-        let a_inv = a
-            .try_inverse()
-            .ok_or_else(|| format!("particle {i}: singular moment matrix"))?;
+        let a_inv = a.try_inverse().ok_or_else(|| NeighbourhoodError {
+            particle: Some(i),
+            reason: "singular moment matrix".into(),
+        })?;
         let wsum: Real = pairs
             .iter()
             .map(|&(r, _)| kernel(r * r, h * h))

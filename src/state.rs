@@ -17,8 +17,10 @@
 //! | then its needle: punctured body (`u32::MAX`: none, or not a needle), entry point (m), hold count, and per hold particle, anchor in the tool frame (m) | u32, f64 × 3, u32, (u32, f64 × 3)… |
 //! | FNV-1a 64 checksum of everything before it | u64 |
 //!
-//! The scene itself (meshes, materials, settings) is not part of the state: a state restores
-//! into a world built the same way. Its size depends on the cuts, grasps and needle holds in
+//! Particles are in each body's particle order (the mesh's nodes sorted for locality, a function
+//! of the mesh alone; version 4 introduced it, so older states are refused rather than
+//! restored onto the wrong particles). The scene itself (meshes, materials, settings) is not
+//! part of the state: a state restores into a world built the same way. Its size depends on the cuts, grasps and needle holds in
 //! force ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
 //!
@@ -37,7 +39,7 @@ use crate::world_state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use std::sync::Arc;
 
 /// Version of the byte format written by [`World::save_state`].
-pub const STATE_VERSION: u32 = 3;
+pub const STATE_VERSION: u32 = 4;
 
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
 const HEADER: usize = 8 + 4 + 4 + 4 + 8;

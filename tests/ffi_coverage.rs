@@ -780,3 +780,81 @@ fn a_body_shared_from_another_world_moves_alike() {
     ok(unsafe { ts_world_body_count(b.0, &mut count) });
     assert_eq!(count, 1, "a refused call added nothing");
 }
+
+/// The C ABI speaks the mesh's node order, whatever order the solver keeps its particles in:
+/// rest positions, tetrahedra and boundary triangles read back as given; fixing particle `k`
+/// holds node `k`; a state set per node reads back per node.
+#[test]
+fn the_c_abi_reads_and_writes_in_the_mesh_node_order() {
+    let w = W::new(&settings());
+    let id = w.add_cube([-SIZE / 2.0; 3], 0.0);
+    let m = mesh::lattice_box(
+        Vec3::repeat(-SIZE / 2.0),
+        Vec3::repeat(SIZE / 2.0),
+        [3, 3, 3],
+    );
+    let n = m.nodes.len();
+    // The solver's order (a function of the nodes alone) differs from the lattice's: the
+    // mapping below is exercised.
+    let model = tissuesim::BodyModel::new(&m, &tissuesim::BodyOptions::default()).unwrap();
+    let order = model.particle_order();
+    assert!((0..n).any(|i| order.mesh_index(i) != i), "identity order");
+    let flat = |v: &[Vec3]| v.iter().flat_map(|p| [p.x, p.y, p.z]).collect::<Vec<f64>>();
+    let mut rest = vec![0.0; 3 * n];
+    ok(unsafe { ts_body_rest_positions(w.0, id, rest.as_mut_ptr(), rest.len()) });
+    assert_eq!(rest, flat(&m.nodes));
+    assert_eq!(w.positions(id), flat(&m.nodes));
+    let mut tets = vec![0; 4 * m.tets.len()];
+    ok(unsafe { ts_body_tets(w.0, id, tets.as_mut_ptr(), tets.len()) });
+    assert_eq!(tets, m.tets.iter().flatten().copied().collect::<Vec<u32>>());
+    let boundary = m.boundary_triangles();
+    let mut tris = vec![0; 3 * boundary.len()];
+    ok(unsafe { ts_body_boundary_triangles(w.0, id, tris.as_mut_ptr(), tris.len()) });
+    assert_eq!(
+        tris,
+        boundary.iter().flatten().copied().collect::<Vec<u32>>()
+    );
+    // Fix the top face's nodes by index and a node of the bottom face: they stay put.
+    let bottom = (0..n).find(|&k| m.nodes[k].y < -SIZE / 2.0 + 1e-9).unwrap();
+    let mut fixed: Vec<u32> = (0..n as u32)
+        .filter(|&k| m.nodes[k as usize].y > SIZE / 2.0 - 1e-9)
+        .collect();
+    fixed.push(bottom as u32);
+    ok(unsafe { ts_body_fix_particles(w.0, id, fixed.as_ptr(), fixed.len()) });
+    let mut flags = vec![9u8; n];
+    ok(unsafe { ts_body_fixed_flags(w.0, id, flags.as_mut_ptr(), flags.len()) });
+    for (k, f) in flags.iter().enumerate() {
+        assert_eq!(*f == 1, fixed.contains(&(k as u32)), "node {k}");
+    }
+    w.step(20);
+    let x = w.positions(id);
+    for k in 0..n {
+        let moved = (0..3).any(|c| x[3 * k + c] != m.nodes[k][c]);
+        assert_eq!(moved, !fixed.contains(&(k as u32)), "node {k}");
+    }
+    // A state given per node reads back per node.
+    let shifted: Vec<f64> = (0..n)
+        .flat_map(|k| [m.nodes[k].x + 1e-5 * k as f64, m.nodes[k].y, m.nodes[k].z])
+        .collect();
+    let speeds: Vec<f64> = (0..n).flat_map(|k| [0.0, 1e-3 * k as f64, 0.0]).collect();
+    ok(unsafe {
+        ts_body_set_state(
+            w.0,
+            id,
+            shifted.as_ptr(),
+            shifted.len(),
+            speeds.as_ptr(),
+            speeds.len(),
+        )
+    });
+    assert_eq!(w.positions(id), shifted);
+    let v = w.velocities(id);
+    for k in 0..n {
+        let expected = if fixed.contains(&(k as u32)) {
+            0.0
+        } else {
+            1e-3 * k as f64
+        };
+        assert_eq!(v[3 * k + 1], expected, "node {k}");
+    }
+}

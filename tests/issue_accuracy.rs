@@ -26,7 +26,7 @@ fn reference(file: &str) -> HashMap<usize, Vec3> {
         .collect()
 }
 
-/// Relative L2 error of the linear sag of `mesh` (fixed particles `fixed`, node ids `ids`)
+/// Relative L2 error of the linear sag of `mesh` (fixed mesh nodes `fixed`, node ids `ids`)
 /// against the reference `file`.
 fn sag_error(
     mesh: &TetMesh,
@@ -47,8 +47,12 @@ fn sag_error(
             },
         )
         .unwrap();
-    world.fix_particles(id, fixed).unwrap();
+    let order = world.body(id).unwrap().particle_order().clone();
+    world
+        .fix_particles(id, &order.particles_of(fixed).unwrap())
+        .unwrap();
     let u = statics::linear_gravity_sag(world.body(id).unwrap(), Vec3::new(0.0, -g, 0.0)).unwrap();
+    let u = order.to_mesh_order(&u);
     let r = reference(file);
     let (mut e, mut n) = (0.0, 0.0);
     for (i, ui) in u.iter().enumerate() {

@@ -16,15 +16,14 @@ fn interior_error(mesh: &TetMesh, options: &BodyOptions, settings: Settings) -> 
     let mut world = World::new(settings).unwrap();
     let id = world.add_body(mesh, options).unwrap();
     let boundary: Vec<u32> = {
-        let mut on = vec![false; mesh.nodes.len()];
-        for t in mesh.boundary_triangles() {
-            for k in t {
-                on[k as usize] = true;
+        let body = world.body(id).unwrap();
+        let mut on = vec![false; body.particle_count()];
+        for t in body.boundary_triangles() {
+            for &i in t {
+                on[i as usize] = true;
             }
         }
-        (0..mesh.nodes.len() as u32)
-            .filter(|&k| on[k as usize])
-            .collect()
+        (0..on.len() as u32).filter(|&i| on[i as usize]).collect()
     };
     world.fix_particles(id, &boundary).unwrap();
     let body = world.body(id).unwrap();

@@ -403,7 +403,11 @@ fn explodes(limits: tissuesim::DivergenceLimits, x: &[Vec3], v: &[Vec3], why: &s
 #[test]
 fn finite_explosions_are_rolled_back_and_reported() {
     use tissuesim::DivergenceLimits;
-    let rest = cube().nodes;
+    // The body's rest positions, in its particle order.
+    let rest = tissuesim::BodyModel::new(&cube(), &BodyOptions::default())
+        .unwrap()
+        .rest_positions()
+        .to_vec();
     let size = 0.1 * 3.0f64.sqrt();
     let still = vec![Vec3::zeros(); rest.len()];
     // One particle at 500 body sizes per second (accepted as a state, beyond the step's 250).

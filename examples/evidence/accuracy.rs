@@ -170,24 +170,25 @@ fn build(run: &StaticRun) -> Res<(World, BodyId, TetMesh, usize)> {
     } else {
         let (lo, hi) = mesh.bounding_box();
         let thr = hi.y - 0.1 * (hi.y - lo.y);
-        let idx: Vec<u32> = (0..mesh.nodes.len() as u32)
-            .filter(|&i| mesh.nodes[i as usize].y >= thr)
+        let nodes: Vec<u32> = (0..mesh.nodes.len() as u32)
+            .filter(|&k| mesh.nodes[k as usize].y >= thr)
             .collect();
-        world.fix_particles(id, &idx)?;
-        idx.len()
+        let particles = world.body(id)?.particle_order().particles_of(&nodes);
+        world.fix_particles(id, &particles.ok_or("fixed node out of range")?)?;
+        nodes.len()
     };
     Ok((world, id, mesh, fixed))
 }
 
-/// Node id of particle `i` in the reference CSV's numbering.
-fn node_id(scene: &str, mesh: &TetMesh, i: usize) -> usize {
+/// Node id of mesh node `k` in the reference CSV's numbering.
+fn node_id(scene: &str, mesh: &TetMesh, k: usize) -> usize {
     if scene == "cantilever" {
         // Lattice index i + 21 (j + 5 k) from the rest position (spacing 5 mm).
-        let p = mesh.nodes[i];
+        let p = mesh.nodes[k];
         let c = |v: Real, lo: Real| ((v - lo) / 0.005).round() as usize;
         c(p.x, 0.0) + 21 * (c(p.y, -0.01) + 5 * c(p.z, -0.01))
     } else {
-        i
+        k
     }
 }
 
@@ -219,7 +220,7 @@ pub fn run_static(run: &StaticRun) -> Res<StaticResult> {
     let rows = (0..b.particle_count())
         .map(|i| {
             (
-                node_id(&run.scene, &mesh, i),
+                node_id(&run.scene, &mesh, b.particle_order().mesh_index(i)),
                 (b.positions()[i] - b.rest_positions()[i])
                     / (run.scale * run.scale * load_factor(&run.scene)),
             )

@@ -21,9 +21,7 @@ pub fn shared_model(mesh: &TetMesh, options: &BodyOptions) -> Result<Arc<BodyMod
     // The registry only holds weak references: a panic elsewhere cannot leave it inconsistent.
     let mut models = MODELS.lock().unwrap_or_else(PoisonError::into_inner);
     models.retain(|m| m.strong_count() > 0);
-    let same = |m: &Arc<BodyModel>| {
-        m.options() == options && m.rest_positions() == mesh.nodes && m.tets() == mesh.tets
-    };
+    let same = |m: &Arc<BodyModel>| m.is_built_from(mesh, options);
     if let Some(model) = models.iter().filter_map(Weak::upgrade).find(same) {
         return Ok(model);
     }

@@ -360,7 +360,20 @@ pub unsafe extern "C" fn ts_body_fix_particles(
         let idx = unsafe { input_slice(indices, count, "indices")? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
-        h.mutate(|w| w.fix_particles(BodyId(body), idx))
+        let order = h.body(body)?.particle_order();
+        let Some(particles) = order.particles_of(idx) else {
+            let n = order.len();
+            let k = idx
+                .iter()
+                .find(|&&k| k as usize >= n)
+                .copied()
+                .unwrap_or_default();
+            return Err(fail(
+                ts_status::InvalidArgument,
+                format!("particle index {k} out of range (body has {n} particles)"),
+            ));
+        };
+        h.mutate(|w| w.fix_particles(BodyId(body), &particles))
     })
 }
 
@@ -462,7 +475,8 @@ unsafe fn body_array<T: Copy>(
     })
 }
 
-/// Copy a body's vectors into a caller buffer of `len` doubles, without allocating.
+/// Copy a body's per-particle vectors into a caller buffer of `len` doubles in the mesh's node
+/// order, without allocating.
 ///
 /// # Safety
 ///
@@ -479,7 +493,8 @@ unsafe fn body_vectors(
         non_null(out, "out")?;
         // SAFETY: contract of the caller.
         let h = unsafe { world_ref(world)? };
-        let v = get(h.body(body)?);
+        let b = h.body(body)?;
+        let v = get(b);
         let needed = 3 * v.len();
         if len < needed {
             return Err(fail(
@@ -490,7 +505,14 @@ unsafe fn body_vectors(
         // SAFETY: `out` holds at least `len >= needed` writable (possibly uninitialised)
         // doubles by contract.
         let dst = unsafe { std::slice::from_raw_parts_mut(out.cast::<MaybeUninit<f64>>(), needed) };
-        put(dst, v.iter().flat_map(|p| [p.x, p.y, p.z]));
+        let order = b.particle_order();
+        put(
+            dst,
+            (0..v.len()).flat_map(|k| {
+                let p = v[order.particle(k)];
+                [p.x, p.y, p.z]
+            }),
+        );
         Ok(())
     })
 }
@@ -639,7 +661,11 @@ pub unsafe extern "C" fn ts_body_boundary_triangles(
             "boundary triangles",
             "uint32_t",
             |_, b| 3 * b.boundary_triangles().len(),
-            |_, b, dst| put(dst, b.boundary_triangles().iter().flatten().copied()),
+            |_, b, dst| {
+                let order = b.particle_order();
+                let mesh_order = |t: &[u32; 3]| order.mesh_indices_of_array(t);
+                put(dst, b.boundary_triangles().iter().flat_map(mesh_order))
+            },
         )
     }
 }
@@ -682,7 +708,11 @@ pub unsafe extern "C" fn ts_body_tets(
             "tets",
             "uint32_t",
             |_, b| 4 * b.tets().len(),
-            |_, b, dst| put(dst, b.tets().iter().flatten().copied()),
+            |_, b, dst| {
+                let order = b.particle_order();
+                let mesh_order = |t: &[u32; 4]| order.mesh_indices_of_array(t);
+                put(dst, b.tets().iter().flat_map(mesh_order))
+            },
         )
     }
 }
@@ -803,6 +833,19 @@ pub unsafe extern "C" fn ts_body_set_state(
                 .collect())
         };
         let (x, v) = (vectors(x, "positions")?, vectors(v, "velocities")?);
+        let order = h.body(body)?.particle_order();
+        if x.len() != order.len() || v.len() != order.len() {
+            let n = order.len();
+            return Err(fail(
+                ts_status::InvalidArgument,
+                format!(
+                    "set_state needs {n} positions and {n} velocities, got {} and {}",
+                    x.len(),
+                    v.len()
+                ),
+            ));
+        }
+        let (x, v) = (order.to_particle_order(&x), order.to_particle_order(&v));
         h.mutate(|w| w.set_body_state(BodyId(body), &x, &v))
     })
 }
@@ -831,7 +874,13 @@ pub unsafe extern "C" fn ts_body_fixed_flags(
             "fixed flags",
             "bytes",
             |_, b| b.particle_count(),
-            |_, b, dst| put(dst, (0..b.particle_count()).map(|i| b.is_fixed(i) as u8)),
+            |_, b, dst| {
+                let order = b.particle_order();
+                put(
+                    dst,
+                    (0..b.particle_count()).map(|k| b.is_fixed(order.particle(k)) as u8),
+                )
+            },
         )
     }
 }

@@ -15,7 +15,10 @@
 //!   `TS_STATUS_PANIC`, and a world whose mutation panicked is poisoned
 //!   (`TS_STATUS_POISONED` from then on, only `ts_world_free` still works on it);
 //! - arrays are `(pointer, length)` pairs; output arrays are caller buffers whose length is
-//!   given in elements of the pointed-to type (doubles, `uint32_t`s or bytes).
+//!   given in elements of the pointed-to type (doubles, `uint32_t`s or bytes);
+//! - particle `k` of a body is node `k` of its mesh (after unreferenced nodes are removed,
+//!   `ts_body_source_indices`): every per-particle array and index reads and writes in the
+//!   mesh's node order, whatever order the solver keeps internally.
 //!
 //! Thread rules: a world may be used by one thread at a time (it may move between threads);
 //! different worlds are independent and may be stepped concurrently. The last error message
