@@ -159,7 +159,8 @@ impl World {
             .ok_or(Error::UnknownBody(id.0))
     }
     /// Set the positions (m) and velocities (m/s) of every particle of a body, e.g. an initial
-    /// condition. Both slices must have one entry per particle and be finite, within
+    /// condition. Both slices must have one entry per particle, in particle order
+    /// ([`Body::particle_order`](crate::Body::particle_order)), and be finite, within
     /// [`STATE_POSITION_LIMIT`](crate::STATE_POSITION_LIMIT) body sizes of the body's
     /// rest centre and below [`STATE_SPEED_LIMIT`](crate::STATE_SPEED_LIMIT) body sizes
     /// per second; fixed particles take the given position and zero velocity. Nothing changes
@@ -231,8 +232,10 @@ impl World {
         surface.update(body.positions());
         Ok(surface)
     }
-    /// Fix the particles with the given indices (they keep their current position). Nothing is
-    /// fixed if any index is out of range.
+    /// Fix the particles with the given indices (particle order:
+    /// [`ParticleOrder::particles_of`](crate::ParticleOrder::particles_of) converts mesh node
+    /// indices). They keep their current position. Nothing is fixed if any index is out of
+    /// range.
     pub fn fix_particles(&mut self, id: BodyId, indices: &[u32]) -> Result<(), Error> {
         let body = self.body_mut(id)?;
         let n = body.particle_count();
