@@ -93,19 +93,13 @@ impl ParticleOrder {
     /// Panics when the lengths differ.
     pub fn to_mesh_order<T: Copy>(&self, per_particle: &[T]) -> Vec<T> {
         assert_eq!(per_particle.len(), self.len(), "one value per particle");
-        self.particle_index
-            .iter()
-            .map(|&i| per_particle[i as usize])
-            .collect()
+        gather(per_particle, &self.particle_index)
     }
     /// A per-node array (mesh order) rearranged into particle order. Panics when the lengths
     /// differ.
     pub fn to_particle_order<T: Copy>(&self, per_node: &[T]) -> Vec<T> {
         assert_eq!(per_node.len(), self.len(), "one value per mesh node");
-        self.mesh_index
-            .iter()
-            .map(|&k| per_node[k as usize])
-            .collect()
+        gather(per_node, &self.mesh_index)
     }
     /// Particle indices of a list of mesh node indices (`None` if one is out of range).
     pub fn particles_of(&self, nodes: &[u32]) -> Option<Vec<u32>> {
@@ -135,6 +129,11 @@ impl ParticleOrder {
     pub(crate) fn mesh_indices_of_array<const N: usize>(&self, particles: &[u32; N]) -> [u32; N] {
         particles.map(|i| self.mesh_index[i as usize])
     }
+}
+
+/// `values[at[0]], values[at[1]], …`.
+fn gather<T: Copy>(values: &[T], at: &[u32]) -> Vec<T> {
+    at.iter().map(|&k| values[k as usize]).collect()
 }
 
 /// The 21 low bits of `v` spread to every third bit (bit `b` to bit `3b`).
