@@ -360,19 +360,19 @@ pub unsafe extern "C" fn ts_body_fix_particles(
         let idx = unsafe { input_slice(indices, count, "indices")? };
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
+        // Node k is particle order.particle(k); an index out of range stays as it is, for
+        // World::fix_particles to refuse.
         let order = h.body(body)?.particle_order();
-        let Some(particles) = order.particles_of(idx) else {
-            let n = order.len();
-            let k = idx
-                .iter()
-                .find(|&&k| k as usize >= n)
-                .copied()
-                .unwrap_or_default();
-            return Err(fail(
-                ts_status::InvalidArgument,
-                format!("particle index {k} out of range (body has {n} particles)"),
-            ));
-        };
+        let particles: Vec<u32> = idx
+            .iter()
+            .map(|&k| {
+                if (k as usize) < order.len() {
+                    order.particle(k as usize) as u32
+                } else {
+                    k
+                }
+            })
+            .collect();
         h.mutate(|w| w.fix_particles(BodyId(body), &particles))
     })
 }
@@ -833,19 +833,17 @@ pub unsafe extern "C" fn ts_body_set_state(
                 .collect())
         };
         let (x, v) = (vectors(x, "positions")?, vectors(v, "velocities")?);
+        // Into particle order; arrays of the wrong length stay as they are, for
+        // World::set_body_state to refuse.
         let order = h.body(body)?.particle_order();
-        if x.len() != order.len() || v.len() != order.len() {
-            let n = order.len();
-            return Err(fail(
-                ts_status::InvalidArgument,
-                format!(
-                    "set_state needs {n} positions and {n} velocities, got {} and {}",
-                    x.len(),
-                    v.len()
-                ),
-            ));
-        }
-        let (x, v) = (order.to_particle_order(&x), order.to_particle_order(&v));
+        let reorder = |a: Vec<Vec3>| {
+            if a.len() == order.len() {
+                order.to_particle_order(&a)
+            } else {
+                a
+            }
+        };
+        let (x, v) = (reorder(x), reorder(v));
         h.mutate(|w| w.set_body_state(BodyId(body), &x, &v))
     })
 }
