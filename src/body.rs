@@ -461,7 +461,7 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.state.x.len()];
         let mut rotation = vec![Quat::identity(); self.state.x.len()];
-        let mut pair_force = vec![Vec3::zeros(); self.model.nbr.pair_count()];
+        let mut pair_force = vec![Vec3::zeros(); self.model.nbr.slot_count()];
         let mut own_force = vec![Vec3::zeros(); self.state.x.len()];
         let zero = vec![Vec3::zeros(); self.state.x.len()];
         let input = ForceInputs {

@@ -192,6 +192,7 @@ impl BodyModel {
             + size_of_val(self.tet_rest_volume.as_slice())
             + size_of_val(self.boundary.as_slice())
             + size_of_val(n.offsets.as_slice())
+            + size_of_val(n.ends.as_slice())
             + size_of_val(n.index.as_slice())
             + n.rest_offset.heap_bytes()
             + n.gradient.heap_bytes()

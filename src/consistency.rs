@@ -92,15 +92,20 @@ pub fn correct_gradients(
     let rhs: Vec<Vec3> = residual.iter().map(|r| -r).collect();
     let mut lambda = vec![Vec3::zeros(); n];
     let iterations = op.solve(&rhs, &mut lambda);
-    // ΔG_i = v_i Π_i A_i Λ.
-    let mut delta = Vec::with_capacity(nbr.pair_count());
+    // ΔG_i = v_i Π_i A_i Λ, kept apart until every particle's is computed from the old
+    // gradients.
+    let mut delta = vec![Vec3::zeros(); nbr.slot_count()];
     let mut y = Vec::new();
     for (i, vi) in volume.iter().enumerate() {
         op.projected_differences(i, &lambda, &mut y);
-        delta.extend(y.iter().map(|yj| yj * *vi));
+        for (e, yj) in nbr.range(i).zip(&y) {
+            delta[e] = yj * *vi;
+        }
     }
-    for (e, d) in delta.iter().enumerate() {
-        nbr.gradient.set(e, nbr.gradient.get(e) + d);
+    for i in 0..n {
+        for e in nbr.range(i) {
+            nbr.gradient.set(e, nbr.gradient.get(e) + delta[e]);
+        }
     }
     let after = norm(&integration_residual(nbr, volume, &b)) / scale;
     CorrectionReport {

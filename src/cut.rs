@@ -75,7 +75,7 @@ impl CutState {
             original: Arc::clone(&body.model),
             inertial_mass: body.inertial_mass.clone(),
             stiffness: body.diagonal_stiffness(),
-            pair_cut: vec![false; body.model.nbr.pair_count()],
+            pair_cut: vec![false; body.model.nbr.slot_count()],
             tet_cut: vec![false; body.model.tets.len()],
             sets: Arc::default(),
         }
@@ -361,13 +361,13 @@ pub(crate) fn restore(body: &mut Body, sets: &Option<Arc<CutSets>>) {
     apply(body, state, None);
 }
 
-/// Number of load-time pairs and tetrahedra of `body` (the ranges of the saved cut sets).
+/// Number of load-time pair slots and tetrahedra of `body` (the ranges of the saved cut sets).
 pub(crate) fn load_time_counts(body: &Body) -> (usize, usize) {
     let tets = body
         .cuts
         .as_ref()
         .map_or(body.model.tets.len(), |c| c.original.tets.len());
-    (body.model.nbr.pair_count(), tets)
+    (body.model.nbr.slot_count(), tets)
 }
 
 impl Body {

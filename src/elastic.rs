@@ -31,6 +31,7 @@ use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
 use crate::parallel::{Pool, SharedSlice};
 use nalgebra::Quaternion;
+use std::ops::Range;
 
 /// The constants of the elastic model of one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -190,7 +191,7 @@ pub struct ForceInputs<'a> {
 /// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
 ///
 /// `rotation` holds each particle's rotation, warm-started and updated in place; `pair_force`
-/// (one entry per pair) and `own_force` (one per particle) are scratch: no allocation inside.
+/// (one entry per pair slot) and `own_force` (one per particle) are scratch: no allocation inside.
 ///
 /// Every particle `i` computes its deformation gradient, rotation and stress and the force
 /// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). On one thread the pair forces
@@ -214,8 +215,7 @@ pub fn accumulate_forces(
     if pool.threads() == 1 {
         let mut buffer = PairBuffer::new();
         for i in 0..n {
-            let range = nbr.range(i);
-            let pf = &mut pair_force[range.clone()];
+            let pf = &mut pair_force[nbr.slots(i)];
             let fi = particle_pair_forces(
                 model,
                 input,
@@ -225,7 +225,7 @@ pub fn accumulate_forces(
                 &mut buffer,
                 pf,
             );
-            for (&j, g) in nbr.index[range].iter().zip(pf.iter()) {
+            for (&j, g) in nbr.index[nbr.range(i)].iter().zip(pf.iter()) {
                 force[j as usize] -= g;
             }
             force[i] += fi;
@@ -249,8 +249,8 @@ pub fn accumulate_forces(
         };
         let mut buffer = PairBuffer::new();
         for (k, i) in particles.enumerate() {
-            let range = nbr.range(i);
-            let local = range.start - first_pair..range.end - first_pair;
+            let slots = nbr.slots(i);
+            let local = slots.start - first_pair..slots.end - first_pair;
             own[k] = particle_pair_forces(
                 model,
                 input,
@@ -263,7 +263,7 @@ pub fn accumulate_forces(
         }
     });
     // SAFETY: pass A has finished; pass B only reads these.
-    let (pairs, own) = unsafe { (pairs.range(0..nbr.pair_count()), own.range(0..n)) };
+    let (pairs, own) = unsafe { (pairs.range(0..nbr.slot_count()), own.range(0..n)) };
     let forces = SharedSlice::new(force);
     pool.run(&|share| {
         let particles = pool.share(share, n);
@@ -286,15 +286,15 @@ pub fn accumulate_forces(
     });
 }
 
-/// Pair data of one particle held between the passes of [`particle_pair_forces`], four pairs a
-/// chunk: the current offsets `x_ij` (m) and hourglass residuals `ε_ij` (m).
+/// Pair data of one particle held between the passes of [`particle_pair_forces`], four pair
+/// slots a chunk: the current offsets `x_ij` (m) and hourglass residuals `ε_ij` (m).
 struct PairBuffer {
     offset: [V4; MAX_CHUNKS],
     residual: [V4; MAX_CHUNKS],
 }
 
-/// Chunks of four pairs a particle may have: the largest neighbourhood that
-/// [`crate::neighbours::build`] accepts.
+/// Chunks of four pair slots a particle may have: the largest neighbourhood that
+/// [`crate::neighbours::build`] accepts, padded.
 const MAX_CHUNKS: usize = MAX_FIXED_NEIGHBOURS.div_ceil(LANES);
 
 impl PairBuffer {
@@ -306,10 +306,69 @@ impl PairBuffer {
     }
 }
 
+/// The rest data of four consecutive pair slots: neighbours `j`, rest offsets `u_ij` (m), MLS
+/// gradients `d_ij` (1/m) and hourglass weights `ŵ_ij / |u_ij|²` (1/m²).
+struct PairChunk {
+    j: [usize; LANES],
+    u: V4,
+    d: V4,
+    w: F4,
+}
+
+/// The rest data of a particle's pair slots (a whole number of chunks, see
+/// [`crate::neighbours::PAIR_SLOT_ALIGNMENT`]), four slots a chunk.
+struct PairChunks<'a> {
+    j: &'a [[u32; LANES]],
+    u: [&'a [[Real; LANES]]; 3],
+    d: [&'a [[Real; LANES]]; 3],
+    w: &'a [[Real; LANES]],
+}
+
+impl<'a> PairChunks<'a> {
+    #[inline(always)]
+    fn new(nbr: &'a Neighbourhoods, slots: Range<usize>) -> Self {
+        fn whole<T>(s: &[T]) -> &[[T; LANES]] {
+            let (chunks, rest) = s.as_chunks();
+            assert!(rest.is_empty(), "pair slots come in whole chunks");
+            chunks
+        }
+        let (u, d) = (&nbr.rest_offset, &nbr.gradient);
+        let s = slots;
+        let out = PairChunks {
+            j: whole(&nbr.index[s.clone()]),
+            u: [&u.x, &u.y, &u.z].map(|c| whole(&c[s.clone()])),
+            d: [&d.x, &d.y, &d.z].map(|c| whole(&c[s.clone()])),
+            w: whole(&nbr.hourglass_weight[s]),
+        };
+        let n = out.len();
+        assert!(out.u.iter().chain(&out.d).all(|c| c.len() == n) && out.w.len() == n);
+        out
+    }
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.j.len()
+    }
+    #[inline(always)]
+    fn get(&self, k: usize) -> PairChunk {
+        let v = |c: &[&[[Real; LANES]]; 3]| V4 {
+            x: F4::new(c[0][k]),
+            y: F4::new(c[1][k]),
+            z: F4::new(c[2][k]),
+        };
+        PairChunk {
+            j: self.j[k].map(|j| j as usize),
+            u: v(&self.u),
+            d: v(&self.d),
+            w: F4::new(self.w[k]),
+        }
+    }
+}
+
 /// Particle `i`'s part of the first pass: its deformation gradient, rotation (warm-started in
-/// `q`) and stress, the force `g_ij` on `i` of each of its pairs written to `pair_force` (one
-/// entry per pair of `i`), and their sum returned. Three passes over the pairs of `i`, four
-/// pairs at a time (see [`crate::lanes`]).
+/// `q`) and stress, the force `g_ij` on `i` of each of its pair slots written to `pair_force`
+/// (one entry per slot of `i`; zero for the padding), and their sum returned. Three passes over
+/// the slots of `i`, four at a time (see [`crate::lanes`]); a padding slot (neighbour `i`, zero
+/// rest data) adds nothing anywhere.
 #[inline]
 fn particle_pair_forces(
     model: &ElasticModel,
@@ -321,30 +380,18 @@ fn particle_pair_forces(
     pair_force: &mut [Vec3],
 ) -> Vec3 {
     let nbr = input.nbr;
-    let range = nbr.range(i);
-    let index = &nbr.index[range.clone()];
-    let u = nbr.rest_offset.slices(range.clone());
-    let d = nbr.gradient.slices(range.clone());
-    let hw = &nbr.hourglass_weight[range];
-    let pairs = index.len();
-    let chunks = pairs.div_ceil(LANES);
-    // Lanes past the last pair take j = i (offset 0) and load zero u, d and weight: they add
-    // nothing anywhere below.
-    let neighbours = |k: usize| -> [usize; LANES] {
-        match index.get(LANES * k..LANES * k + LANES) {
-            Some(c) => [c[0], c[1], c[2], c[3]].map(|j| j as usize),
-            None => std::array::from_fn(|l| index.get(LANES * k + l).map_or(i, |&j| j as usize)),
-        }
-    };
+    let rest = PairChunks::new(nbr, nbr.slots(i));
+    let chunks = rest.len();
     let offset = &mut buffer.offset[..chunks];
     let residual = &mut buffer.residual[..chunks];
+    let pair_force = &mut pair_force.as_chunks_mut::<LANES>().0[..chunks];
     // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next passes.
     let xi = V4::splat(&input.x[i]);
     let mut fsum = M4::default();
     for (k, o) in offset.iter_mut().enumerate() {
-        *o = V4::gather(input.x, &neighbours(k)) - xi;
-        let du = *o - V4::load(&u, LANES * k);
-        fsum.add_outer(&du, &V4::load(&d, LANES * k));
+        let c = rest.get(k);
+        *o = V4::gather(input.x, &c.j) - xi;
+        fsum.add_outer(&(*o - c.u), &c.d);
     }
     let f = fsum.sum() + Mat3::identity();
     let r = extract_rotation(&f, q, rotation_iterations);
@@ -356,10 +403,9 @@ fn particle_pair_forces(
     if model.hourglass != 0.0 {
         let fl = M4::splat(&f);
         for (k, (o, eps)) in offset.iter().zip(residual.iter_mut()).enumerate() {
-            let uk = V4::load(&u, LANES * k);
-            *eps = fl.mul(&uk) - *o;
-            let cw = F4::load(hw, LANES * k) * c_scale;
-            qsum.add_outer(eps, &uk.scale(cw));
+            let c = rest.get(k);
+            *eps = fl.mul(&c.u) - *o;
+            qsum.add_outer(eps, &c.u.scale(c.w * c_scale));
         }
     } else {
         residual.fill(V4::default());
@@ -370,15 +416,13 @@ fn particle_pair_forces(
     let vel_i = V4::splat(&input.v[i]);
     let mut fi = V4::default();
     for (k, (o, eps)) in offset.iter().zip(residual.iter()).enumerate() {
-        let e = LANES * k;
-        let dk = V4::load(&d, e);
-        let cw = F4::load(hw, e) * c_scale;
-        let mut g = m.mul(&dk) - eps.scale(cw);
+        let c = rest.get(k);
+        let mut g = m.mul(&c.d) - eps.scale(c.w * c_scale);
         if damping > 0.0 {
             // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
             let len2 = o.dot(o);
-            let rate = (V4::gather(input.v, &neighbours(k)) - vel_i).dot(o);
-            let k2 = dk.dot(&dk);
+            let rate = (V4::gather(input.v, &c.j) - vel_i).dot(o);
+            let k2 = c.d.dot(&c.d);
             let (len2, k2, rate) = (len2.to_array(), k2.to_array(), rate.to_array());
             let s = F4::from_fn(|l| {
                 if len2[l] > 1.0e-30 {
@@ -389,7 +433,7 @@ fn particle_pair_forces(
             });
             g += o.scale(s);
         }
-        g.store(&mut pair_force[e..(e + LANES).min(pairs)]);
+        g.store(&mut pair_force[k]);
         fi += g;
     }
     fi.sum()
@@ -450,7 +494,7 @@ mod tests {
     fn forces(model: &ElasticModel, input: &ForceInputs<'_>, threads: usize) -> Vec<Vec3> {
         let n = input.x.len();
         let mut rotation = vec![Quat::identity(); n];
-        let mut pair_force = vec![Vec3::zeros(); input.nbr.pair_count()];
+        let mut pair_force = vec![Vec3::zeros(); input.nbr.slot_count()];
         let mut own_force = vec![Vec3::zeros(); n];
         let mut force = vec![Vec3::zeros(); n];
         accumulate_forces(

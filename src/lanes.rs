@@ -6,7 +6,6 @@
 //! every build gives the same bits. Only [`F4::sum`] crosses lanes, in a fixed order.
 
 use crate::math::{Mat3, Real, Vec3};
-use crate::vec3_array::Vec3Slices;
 use std::ops::{Add, AddAssign, Mul, Sub};
 use wide::f64x4;
 
@@ -32,20 +31,6 @@ impl F4 {
     #[inline(always)]
     pub(crate) fn to_array(self) -> [Real; LANES] {
         self.0.to_array()
-    }
-    /// `s[start..start + 4]`, lanes past the end of `s` zero.
-    #[inline(always)]
-    pub(crate) fn load(s: &[Real], start: usize) -> F4 {
-        match s.get(start..start + LANES) {
-            Some(c) => F4::new([c[0], c[1], c[2], c[3]]),
-            None => {
-                let mut out = [0.0; LANES];
-                for (o, v) in out.iter_mut().zip(&s[start..]) {
-                    *o = *v;
-                }
-                F4::new(out)
-            }
-        }
     }
     /// Lane `l` is `f(l)`: lane-wise selections.
     #[inline(always)]
@@ -109,15 +94,6 @@ impl V4 {
             z: F4::splat(v.z),
         }
     }
-    /// Vectors `start..start + 4` of `a`, lanes past its end zero.
-    #[inline(always)]
-    pub(crate) fn load(a: &Vec3Slices<'_>, start: usize) -> V4 {
-        V4 {
-            x: F4::load(a.x, start),
-            y: F4::load(a.y, start),
-            z: F4::load(a.z, start),
-        }
-    }
     /// `field[j[l]]` in lane `l`.
     #[inline(always)]
     pub(crate) fn gather(field: &[Vec3], j: &[usize; LANES]) -> V4 {
@@ -142,9 +118,9 @@ impl V4 {
             z: self.z * s,
         }
     }
-    /// Write vector `l` to `out[l]` for every `l < out.len()` (at most 4).
+    /// Write vector `l` to `out[l]`.
     #[inline(always)]
-    pub(crate) fn store(&self, out: &mut [Vec3]) {
+    pub(crate) fn store(&self, out: &mut [Vec3; LANES]) {
         let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
         for (l, o) in out.iter_mut().enumerate() {
             *o = Vec3::new(x[l], y[l], z[l]);
@@ -237,10 +213,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_load_past_the_end_fills_zeros_and_sums_in_order() {
-        let s = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
-        assert_eq!(F4::load(&s, 1), F4::new([2.0, 3.0, 4.0, 5.0]));
-        assert_eq!(F4::load(&s, 4), F4::new([5.0, 6.0, 0.0, 0.0]));
+    fn lanes_store_in_order_and_sum_in_a_fixed_order() {
+        let v = V4 {
+            x: F4::new([1.0, 2.0, 3.0, 4.0]),
+            y: F4::new([5.0, 6.0, 7.0, 8.0]),
+            z: F4::new([9.0, 10.0, 11.0, 12.0]),
+        };
+        let mut out = [Vec3::zeros(); LANES];
+        v.store(&mut out);
+        assert_eq!(out[1], Vec3::new(2.0, 6.0, 10.0));
+        assert_eq!(out[3], Vec3::new(4.0, 8.0, 12.0));
         let a = F4::new([1e16, 1.0, -1e16, 1.0]);
         // Pairwise, each 1 is rounded away against 1e16: 0. Left to right would give 1.
         assert_eq!(a.sum(), 0.0);

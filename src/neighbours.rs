@@ -6,7 +6,14 @@
 //! `u_ij = X_j - X_i`, the poly6 kernel `w_ij = (1 - |u_ij|²/h_i²)³` and the moment matrix
 //! `A_i = Σ_j w_ij u_ij u_ijᵀ`, the deformation gradient is `F_i = Σ_j x_ij d_ijᵀ` with
 //! `d_ij = w_ij A_i⁻¹ u_ij`, stored per pair.
+//!
+//! Each particle's pairs start at a multiple of [`PAIR_SLOT_ALIGNMENT`] in the per-pair arrays
+//! and are followed by inert padding slots up to the next multiple (neighbour `i` itself, zero
+//! offset, gradient and weight), so the force pass reads whole chunks of four pairs with no
+//! partial last chunk. [`Neighbourhoods::range`] gives a particle's real pairs and
+//! [`Neighbourhoods::slots`] its padded run.
 
+use crate::lanes::LANES;
 use crate::math::{Mat3, Real, Vec3};
 use crate::vec3_array::Vec3Array;
 
@@ -21,13 +28,24 @@ pub const MAX_NEIGHBOURS: usize = 96;
 /// and memory grow with it).
 pub const MAX_FIXED_NEIGHBOURS: usize = 4 * MAX_NEIGHBOURS;
 
+/// Every particle's run of pair slots starts at a multiple of this and is this many slots
+/// long, or a multiple of it (the force pass's lane count).
+pub const PAIR_SLOT_ALIGNMENT: usize = LANES;
+
 /// Neighbour lists of every particle of a body (CSR) and their rest-state quantities.
+///
+/// The per-pair arrays (`index`, `rest_offset`, `gradient`, `hourglass_weight`) hold, for each
+/// particle in turn, its pairs then padding slots up to a multiple of [`PAIR_SLOT_ALIGNMENT`];
+/// a padding slot of particle `i` has neighbour `i`, zero offset, zero gradient and zero weight,
+/// and adds nothing to any sum. A pair index `e` is an index into these arrays.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Neighbourhoods {
-    /// `offsets[i]..offsets[i+1]` is the range of particle `i`'s pairs in the arrays below
-    /// (length: particles + 1).
+    /// `offsets[i]..offsets[i+1]` is particle `i`'s run of pair slots in the arrays below, its
+    /// pairs first (length: particles + 1; every entry a multiple of [`PAIR_SLOT_ALIGNMENT`]).
     pub offsets: Vec<u32>,
-    /// Neighbour index `j` of each pair.
+    /// `offsets[i]..ends[i]` is the range of particle `i`'s pairs (length: particles).
+    pub ends: Vec<u32>,
+    /// Neighbour index `j` of each pair slot.
     pub index: Vec<u32>,
     /// Rest offset `u_ij = X_j - X_i` of each pair (m), by component.
     pub rest_offset: Vec3Array,
@@ -51,13 +69,23 @@ impl Neighbourhoods {
     pub fn particle_count(&self) -> usize {
         self.offsets.len() - 1
     }
-    /// The pair range of particle `i`.
+    /// The pair range of particle `i` (its real pairs, without the padding).
     #[inline]
     pub fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.ends[i] as usize
+    }
+    /// The run of pair slots of particle `i`: its pairs, then padding up to a multiple of
+    /// [`PAIR_SLOT_ALIGNMENT`].
+    #[inline]
+    pub fn slots(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
-    /// Total number of (directed) pairs.
+    /// Total number of (directed) pairs, padding excluded.
     pub fn pair_count(&self) -> usize {
+        self.incoming.len()
+    }
+    /// Length of the per-pair arrays: every pair index is below it (padding included).
+    pub fn slot_count(&self) -> usize {
         self.index.len()
     }
     /// The pairs whose neighbour is particle `j`, in increasing pair order.
@@ -103,6 +131,7 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
     let grid = PointGrid::new(rest);
     let mut out = Neighbourhoods {
         offsets: Vec::with_capacity(n + 1),
+        ends: Vec::with_capacity(n),
         index: Vec::new(),
         rest_offset: Vec3Array::default(),
         gradient: Vec3Array::default(),
@@ -185,22 +214,34 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
             out.gradient.push(a_inv * u * w);
             out.hourglass_weight.push(w / wsum / u.norm_squared());
         }
+        out.ends.push(out.index.len() as u32);
+        while !out.index.len().is_multiple_of(PAIR_SLOT_ALIGNMENT) {
+            out.index.push(i as u32);
+            out.rest_offset.push(Vec3::zeros());
+            out.gradient.push(Vec3::zeros());
+            out.hourglass_weight.push(0.0);
+        }
         out.support_radius.push(h);
         out.offsets.push(out.index.len() as u32);
     }
     // The transposed pair lists, by counting sort (pairs stay in increasing order).
     out.incoming_offsets = vec![0; n + 1];
-    for &j in &out.index {
-        out.incoming_offsets[j as usize + 1] += 1;
+    for i in 0..n {
+        for &j in &out.index[out.range(i)] {
+            out.incoming_offsets[j as usize + 1] += 1;
+        }
     }
     for j in 0..n {
         out.incoming_offsets[j + 1] += out.incoming_offsets[j];
     }
     let mut fill = out.incoming_offsets.clone();
-    out.incoming = vec![0; out.index.len()];
-    for (e, &j) in out.index.iter().enumerate() {
-        out.incoming[fill[j as usize] as usize] = e as u32;
-        fill[j as usize] += 1;
+    out.incoming = vec![0; out.incoming_offsets[n] as usize];
+    for i in 0..n {
+        for e in out.range(i) {
+            let j = out.index[e] as usize;
+            out.incoming[fill[j] as usize] = e as u32;
+            fill[j] += 1;
+        }
     }
     Ok(out)
 }
@@ -339,5 +380,72 @@ impl PointGrid {
         let ring = ((h / self.cell).ceil() as usize).max(1);
         self.gather(points, i, ring, out);
         out.retain(|c| c.0 < h);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 5×4×4 lattice (m) with a deterministic jitter, so distances are all different.
+    fn jittered_lattice() -> Vec<Vec3> {
+        let mut points = Vec::new();
+        for i in 0..5 {
+            for j in 0..4 {
+                for k in 0..4 {
+                    let s = (i * 16 + j * 4 + k) as Real;
+                    let jitter = Vec3::new((s * 0.7).sin(), (s * 1.3).cos(), (s * 2.1).sin());
+                    points.push(Vec3::new(i as Real, j as Real, k as Real) + 0.1 * jitter);
+                }
+            }
+        }
+        points
+    }
+
+    /// Each particle's slots start on a chunk boundary and hold its pairs then at most three
+    /// inert padding slots (neighbour itself, zero rest data); the transposed lists and the
+    /// pair count see only the real pairs.
+    #[test]
+    fn pair_slots_are_chunk_aligned_and_padding_is_inert() {
+        let rest = jittered_lattice();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let mut real = 0;
+        let mut padded = 0;
+        for i in 0..rest.len() {
+            let (range, slots) = (nbr.range(i), nbr.slots(i));
+            assert_eq!(range.start, slots.start);
+            assert_eq!(slots.start % PAIR_SLOT_ALIGNMENT, 0);
+            assert_eq!(slots.len() % PAIR_SLOT_ALIGNMENT, 0);
+            assert!(range.end <= slots.end && slots.end - range.end < PAIR_SLOT_ALIGNMENT);
+            assert!(range.len() >= 13, "particle {i}: {} pairs", range.len());
+            for e in range.clone() {
+                assert_ne!(nbr.index[e] as usize, i);
+                assert!(nbr.hourglass_weight[e] > 0.0);
+            }
+            for e in range.end..slots.end {
+                assert_eq!(nbr.index[e] as usize, i);
+                assert_eq!(nbr.rest_offset.get(e), Vec3::zeros());
+                assert_eq!(nbr.gradient.get(e), Vec3::zeros());
+                assert_eq!(nbr.hourglass_weight[e], 0.0);
+                padded += 1;
+            }
+            real += range.len();
+        }
+        assert!(padded > 0, "13 neighbours must leave padding");
+        assert_eq!(nbr.pair_count(), real);
+        assert_eq!(nbr.slot_count(), real + padded);
+        for j in 0..rest.len() {
+            for &e in nbr.incoming(j) {
+                let e = e as usize;
+                let owner = (0..rest.len())
+                    .find(|&i| nbr.slots(i).contains(&e))
+                    .unwrap();
+                assert!(
+                    nbr.range(owner).contains(&e),
+                    "padding slot {e} listed as incoming"
+                );
+                assert_eq!(nbr.index[e] as usize, j);
+            }
+        }
     }
 }

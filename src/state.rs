@@ -11,7 +11,7 @@
 //! | time (s) | f64 |
 //! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
 //! | then its fixed flags, one byte per particle (0 or 1) | u8… |
-//! | then its cut pairs (count, load-time pair indices, increasing) and removed tetrahedra (count, load-time indices, increasing) | u32, u32…, u32, u32… |
+//! | then its cut pairs (count, load-time pair slot indices, increasing) and removed tetrahedra (count, load-time indices, increasing) | u32, u32…, u32, u32… |
 //! | per tool in the world (removed tools left out), in id order: pose, target pose (xyz, wxyz), linear velocity (m/s), force (N), torque (N·m), contact count, max penetration (m) | f64…, u32, f64 |
 //! | then its grasp: slip force (N), attachment count, and per attachment body, particle, anchor in the tool frame (m), compliance (m/N) | f64, u32, (u32, u32, f64 × 4)… |
 //! | then its needle: punctured body (`u32::MAX`: none, or not a needle), entry point (m), hold count, and per hold particle, anchor in the tool frame (m) | u32, f64 × 3, u32, (u32, f64 × 3)… |
@@ -19,7 +19,8 @@
 //!
 //! Particles are in each body's particle order (the mesh's nodes sorted for locality, a function
 //! of the mesh alone; version 4 introduced it, so older states are refused rather than
-//! restored onto the wrong particles). The scene itself (meshes, materials, settings) is not
+//! restored onto the wrong particles). Cut pairs are indices into the neighbourhoods' pair
+//! slots, padded per particle (version 5). The scene itself (meshes, materials, settings) is not
 //! part of the state: a state restores into a world built the same way. Its size depends on the cuts, grasps and needle holds in
 //! force ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
@@ -39,7 +40,7 @@ use crate::world_state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use std::sync::Arc;
 
 /// Version of the byte format written by [`World::save_state`].
-pub const STATE_VERSION: u32 = 4;
+pub const STATE_VERSION: u32 = 5;
 
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
 const HEADER: usize = 8 + 4 + 4 + 4 + 8;

@@ -821,7 +821,7 @@ pub unsafe extern "C" fn ts_body_set_state(
         // SAFETY: contract of this function.
         let h = unsafe { world_mut(world)? };
         let vectors = |xyz: &[f64], name: &str| -> FfiResult<Vec<Vec3>> {
-            if xyz.len() % 3 != 0 {
+            if !xyz.len().is_multiple_of(3) {
                 return Err(fail(
                     ts_status::InvalidArgument,
                     format!("{name}_len {} is not a multiple of 3", xyz.len()),

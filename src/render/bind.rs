@@ -193,7 +193,7 @@ pub fn bind(nodes: &[Vec3], tets: &[[u32; 4]], points: &[Vec3]) -> (Vec<Binding>
             for &t in grid.tets_in(cell) {
                 if let Some(w) = barycentric(p, corners(t as usize)) {
                     let depth = w.iter().copied().fold(Real::MAX, Real::min);
-                    if depth >= -INSIDE_TOLERANCE && best.map_or(true, |(d, _, _)| depth > d) {
+                    if depth >= -INSIDE_TOLERANCE && best.is_none_or(|(d, _, _)| depth > d) {
                         best = Some((depth, t, w));
                     }
                 }

@@ -31,7 +31,7 @@ impl StepScratch {
         StepScratch {
             p: model.rest.clone(),
             force: vec![Vec3::zeros(); n],
-            pair_force: vec![Vec3::zeros(); model.nbr.pair_count()],
+            pair_force: vec![Vec3::zeros(); model.nbr.slot_count()],
             own_force: vec![Vec3::zeros(); n],
             tet_lambda: vec![0.0; model.tets.len()],
         }
