@@ -212,24 +212,14 @@ pub fn accumulate_forces(
 ) {
     let nbr = input.nbr;
     let n = nbr.particle_count();
+    let kernel = Kernel::detect();
+    let pass = ParticlePass {
+        model,
+        input,
+        rotation_iterations,
+    };
     if pool.threads() == 1 {
-        let mut buffer = PairBuffer::new();
-        for i in 0..n {
-            let pf = &mut pair_force[nbr.slots(i)];
-            let fi = particle_pair_forces(
-                model,
-                input,
-                i,
-                &mut rotation[i],
-                rotation_iterations,
-                &mut buffer,
-                pf,
-            );
-            for (&j, g) in nbr.index[nbr.range(i)].iter().zip(pf.iter()) {
-                force[j as usize] -= g;
-            }
-            force[i] += fi;
-        }
+        kernel.scatter(&pass, rotation, pair_force, force);
         return;
     }
     let rotation = SharedSlice::new(rotation);
@@ -247,20 +237,7 @@ pub fn accumulate_forces(
                 own.range(particles.clone()),
             )
         };
-        let mut buffer = PairBuffer::new();
-        for (k, i) in particles.enumerate() {
-            let slots = nbr.slots(i);
-            let local = slots.start - first_pair..slots.end - first_pair;
-            own[k] = particle_pair_forces(
-                model,
-                input,
-                i,
-                &mut rot[k],
-                rotation_iterations,
-                &mut buffer,
-                &mut pf[local],
-            );
-        }
+        kernel.keep(&pass, particles, rot, pf, own);
     });
     // SAFETY: pass A has finished; pass B only reads these.
     let (pairs, own) = unsafe { (pairs.range(0..nbr.slot_count()), own.range(0..n)) };
@@ -284,6 +261,151 @@ pub fn accumulate_forces(
             f[k] = fj;
         }
     });
+}
+
+/// What every particle of a force pass needs besides its own arrays.
+struct ParticlePass<'a, 'b> {
+    model: &'a ElasticModel,
+    input: &'a ForceInputs<'b>,
+    rotation_iterations: u32,
+}
+
+/// One thread: every particle's pair forces, scattered into `force` as they are computed
+/// (`+g_ij` on `i`, `−g_ij` on `j`, in particle order).
+#[inline(always)]
+fn scatter_pass(
+    pass: &ParticlePass<'_, '_>,
+    rotation: &mut [Quat],
+    pair_force: &mut [Vec3],
+    force: &mut [Vec3],
+) {
+    let nbr = pass.input.nbr;
+    let mut buffer = PairBuffer::new();
+    for (i, q) in rotation.iter_mut().enumerate() {
+        let pf = &mut pair_force[nbr.slots(i)];
+        let fi = particle_pair_forces(pass, i, q, &mut buffer, pf);
+        for (&j, g) in nbr.index[nbr.range(i)].iter().zip(pf.iter()) {
+            force[j as usize] -= g;
+        }
+        force[i] += fi;
+    }
+}
+
+/// Pass A of several threads, one share: the pair forces of the particles `particles` kept in
+/// `pair_force` (their slots, from the first particle's) and their sums in `own`.
+#[inline(always)]
+fn keep_pass(
+    pass: &ParticlePass<'_, '_>,
+    particles: Range<usize>,
+    rotation: &mut [Quat],
+    pair_force: &mut [Vec3],
+    own: &mut [Vec3],
+) {
+    let nbr = pass.input.nbr;
+    let first_pair = nbr.offsets[particles.start] as usize;
+    let mut buffer = PairBuffer::new();
+    for (k, i) in particles.enumerate() {
+        let slots = nbr.slots(i);
+        let local = slots.start - first_pair..slots.end - first_pair;
+        own[k] = particle_pair_forces(
+            pass,
+            i,
+            &mut rotation[k],
+            &mut buffer,
+            &mut pair_force[local],
+        );
+    }
+}
+
+/// How the particle loops of the force pass are compiled, chosen at run time.
+///
+/// The pair passes keep a 3×3 matrix of four-lane accumulators, a splatted matrix and the
+/// chunk's operands live at once: more than AVX2's 16 vector registers, so some spill to the
+/// stack every chunk. Processors with AVX-512 (VL) have 32 registers for the same 256-bit
+/// instructions; on them the loops run in a copy compiled with those features. The arithmetic
+/// is the same lane-wise IEEE operations (no fused multiply–add), so both give the same bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kernel {
+    /// Compiled for the build's target (x86-64-v3 in this repository, `.cargo/config.toml`).
+    Build,
+    /// Compiled with AVX-512 F and VL enabled (x86-64 only).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    Avx512,
+}
+
+impl Kernel {
+    /// The best kernel this processor runs.
+    fn detect() -> Kernel {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            return Kernel::Avx512;
+        }
+        Kernel::Build
+    }
+
+    /// [`scatter_pass`] in this kernel's copy.
+    fn scatter(
+        self,
+        pass: &ParticlePass<'_, '_>,
+        rotation: &mut [Quat],
+        pair_force: &mut [Vec3],
+        force: &mut [Vec3],
+    ) {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `detect` returns `Avx512` only on a processor with AVX-512 F and VL.
+            Kernel::Avx512 => unsafe { avx512::scatter_pass(pass, rotation, pair_force, force) },
+            _ => scatter_pass(pass, rotation, pair_force, force),
+        }
+    }
+
+    /// [`keep_pass`] in this kernel's copy.
+    fn keep(
+        self,
+        pass: &ParticlePass<'_, '_>,
+        particles: Range<usize>,
+        rotation: &mut [Quat],
+        pair_force: &mut [Vec3],
+        own: &mut [Vec3],
+    ) {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `scatter`.
+            Kernel::Avx512 => unsafe {
+                avx512::keep_pass(pass, particles, rotation, pair_force, own)
+            },
+            _ => keep_pass(pass, particles, rotation, pair_force, own),
+        }
+    }
+}
+
+/// The particle loops compiled with AVX-512 F and VL (see [`Kernel`]).
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use super::*;
+
+    #[target_feature(enable = "avx512f,avx512vl")]
+    pub(super) fn scatter_pass(
+        pass: &ParticlePass<'_, '_>,
+        rotation: &mut [Quat],
+        pair_force: &mut [Vec3],
+        force: &mut [Vec3],
+    ) {
+        super::scatter_pass(pass, rotation, pair_force, force)
+    }
+
+    #[target_feature(enable = "avx512f,avx512vl")]
+    pub(super) fn keep_pass(
+        pass: &ParticlePass<'_, '_>,
+        particles: Range<usize>,
+        rotation: &mut [Quat],
+        pair_force: &mut [Vec3],
+        own: &mut [Vec3],
+    ) {
+        super::keep_pass(pass, particles, rotation, pair_force, own)
+    }
 }
 
 /// Pair data of one particle held between the passes of [`particle_pair_forces`], four pair
@@ -368,17 +490,17 @@ impl<'a> PairChunks<'a> {
 /// `q`) and stress, the force `g_ij` on `i` of each of its pair slots written to `pair_force`
 /// (one entry per slot of `i`; zero for the padding), and their sum returned. Three passes over
 /// the slots of `i`, four at a time (see [`crate::lanes`]); a padding slot (neighbour `i`, zero
-/// rest data) adds nothing anywhere.
-#[inline]
+/// rest data) adds nothing anywhere. Always inlined, so that [`Kernel`] compiles it into its
+/// copies.
+#[inline(always)]
 fn particle_pair_forces(
-    model: &ElasticModel,
-    input: &ForceInputs<'_>,
+    pass: &ParticlePass<'_, '_>,
     i: usize,
     q: &mut Quat,
-    rotation_iterations: u32,
     buffer: &mut PairBuffer,
     pair_force: &mut [Vec3],
 ) -> Vec3 {
+    let (model, input) = (pass.model, pass.input);
     let nbr = input.nbr;
     let rest = PairChunks::new(nbr, nbr.slots(i));
     let chunks = rest.len();
@@ -394,7 +516,7 @@ fn particle_pair_forces(
         fsum.add_outer(&(*o - c.u), &c.d);
     }
     let f = fsum.sum() + Mat3::identity();
-    let r = extract_rotation(&f, q, rotation_iterations);
+    let r = extract_rotation(&f, q, pass.rotation_iterations);
     let vi = input.volume[i];
     // Pass 2: hourglass residuals ε = F u - x_ij and Q = Σ c ε uᵀ; skipped without hourglass
     // control (ε then multiplies c = 0 below).
@@ -548,6 +670,53 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The AVX-512 copy of the particle loops gives the same bits as the build's own, in the
+    /// scattering (one thread) and the keeping (several) loop, with hourglass control and
+    /// damping on. On a processor without AVX-512 there is only one copy: nothing to compare.
+    #[test]
+    fn every_kernel_gives_the_same_bits() {
+        if Kernel::detect() == Kernel::Build {
+            eprintln!("no AVX-512 on this processor: one kernel only");
+            return;
+        }
+        let rest = jittered_block();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let n = rest.len();
+        let volume: Vec<Real> = (0..n).map(|i| 1.0 + 0.01 * i as Real).collect();
+        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
+        let x = deformed(&rest);
+        let v: Vec<Vec3> = rest
+            .iter()
+            .map(|p| Vec3::new(p.y, -p.z, 0.5 * p.x))
+            .collect();
+        let input = ForceInputs {
+            nbr: &nbr,
+            volume: &volume,
+            x: &x,
+            v: &v,
+        };
+        let pass = ParticlePass {
+            model: &model,
+            input: &input,
+            rotation_iterations: 50,
+        };
+        let run = |kernel: Kernel| {
+            let mut rotation = vec![Quat::identity(); n];
+            let mut pair_force = vec![Vec3::zeros(); nbr.slot_count()];
+            let mut force = vec![Vec3::zeros(); n];
+            kernel.scatter(&pass, &mut rotation, &mut pair_force, &mut force);
+            let mut kept_rotation = vec![Quat::identity(); n];
+            let mut kept = vec![Vec3::zeros(); nbr.slot_count()];
+            let mut own = vec![Vec3::zeros(); n];
+            kernel.keep(&pass, 0..n, &mut kept_rotation, &mut kept, &mut own);
+            assert_eq!(kept, pair_force);
+            (force, rotation, own)
+        };
+        let (force, rotation, own) = run(Kernel::Build);
+        assert!(force.iter().any(|f| f.norm() > 0.0));
+        assert_eq!(run(Kernel::Avx512), (force, rotation, own));
     }
 
     /// The pair dashpot: a rigid rotation's velocities give no damping force, and a
