@@ -119,6 +119,7 @@ impl BodyModel {
         }
         let density = options.material.density;
         let (lo, hi) = mesh.bounding_box();
+        let tet_colouring = TetColouring::new(&mesh.tets, &tet_rest_volume, n);
         Ok(Arc::new(BodyModel {
             options: options.clone(),
             rest: mesh.nodes.clone(),
@@ -134,7 +135,7 @@ impl BodyModel {
                 .unwrap_or_else(|| 0.5 * mesh.mean_edge_length()),
             rest_centre: (lo + hi) * 0.5,
             size: (hi - lo).norm(),
-            tet_colouring: TetColouring::new(&mesh.tets, n),
+            tet_colouring,
             order,
         }))
     }
@@ -200,6 +201,8 @@ impl BodyModel {
             + size_of_val(n.support_radius.as_slice())
             + size_of_val(n.incoming_offsets.as_slice())
             + size_of_val(n.incoming.as_slice())
+            + size_of_val(self.tet_colouring.tets.as_slice())
+            + size_of_val(self.tet_colouring.rest_volume.as_slice())
             + size_of_val(self.tet_colouring.blocks.as_slice())
             + 2 * size_of_val(self.order.mesh_indices())
             + size_of_val(self.tet_colouring.starts.as_slice())

@@ -235,7 +235,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
         }
     }
     model.rest_volume = model.tet_rest_volume.iter().sum();
-    model.tet_colouring = TetColouring::new(&model.tets, n);
+    model.tet_colouring = TetColouring::new(&model.tets, &model.tet_rest_volume, n);
     let mesh = TetMesh {
         nodes: model.rest.clone(),
         tets: model.tets.clone(),

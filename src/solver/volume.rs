@@ -1,7 +1,7 @@
 //! The XPBD tetrahedron volume constraints of a body, one Gauss–Seidel pass in colour order
 //! (`crate::colouring`): the colours in sequence, the blocks of a colour (which share no
-//! particle) split over the thread pool, each block's tetrahedra in their order. The result
-//! does not depend on the thread count.
+//! particle) split over the thread pool, each block's tetrahedra in their order, four blocks
+//! interleaved. The result does not depend on the thread count.
 
 use crate::body::Body;
 use crate::constraints::volume::volume_tet_correction;
@@ -12,6 +12,9 @@ use crate::solver::StepScratch;
 /// Below this many tetrahedra a body's pass stays on one thread: the synchronisation (one
 /// barrier per colour) costs about as much as projecting a few hundred tetrahedra per colour.
 const MIN_PARALLEL_TETS: usize = 4096;
+
+/// Blocks of one colour projected in an interleaved sequence (see `project_volumes`).
+const INTERLEAVED_BLOCKS: usize = 4;
 
 /// One Gauss–Seidel pass over a body's tetrahedron volume constraints for a substep `h` (s),
 /// on its predicted positions in `scratch`. Each constraint's XPBD compliance is the body's
@@ -28,23 +31,41 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
     // SAFETY (both closures): within a colour no two blocks share a particle, and each
     // tetrahedron's multiplier is its own; a share projects only its blocks of the colour, and
     // the shares meet at the barrier before the next colour.
-    let project = |first: u32| {
-        for t in colouring.block(first) {
-            let k = model.tets[t].map(|k| k as usize);
-            let v0 = model.tet_rest_volume[t];
-            let x = k.map(|k| *unsafe { p.element(k) });
-            let w = k.map(|k| body.inv_mass[k]);
-            let lambda = unsafe { lambda.element(t) };
-            let alpha = compliance_per_h2 * v0;
-            if let Some(dp) = volume_tet_correction(x, w, v0, alpha, lambda) {
-                for (k, d) in k.into_iter().zip(dp) {
-                    *unsafe { p.element(k) } += d;
+    let project_tet = |t: usize| {
+        let k = colouring.tets[t].map(|k| k as usize);
+        let v0 = colouring.rest_volume[t];
+        let x = k.map(|k| *unsafe { p.element(k) });
+        let w = k.map(|k| body.inv_mass[k]);
+        let lambda = unsafe { lambda.element(t) };
+        let alpha = compliance_per_h2 * v0;
+        if let Some(dp) = volume_tet_correction(x, w, v0, alpha, lambda) {
+            for (k, d) in k.into_iter().zip(dp) {
+                *unsafe { p.element(k) } += d;
+            }
+        }
+    };
+    // A few blocks of one colour interleaved, tetrahedron by tetrahedron: consecutive
+    // projections then touch different particles and overlap in the processor, where one
+    // block's tetrahedra in a row would each wait for the previous one's writes. The blocks
+    // share no particle, so the result is that of projecting them one after the other.
+    let project = |firsts: &[u32]| {
+        let mut blocks: [std::ops::Range<usize>; INTERLEAVED_BLOCKS] = Default::default();
+        for (b, &first) in blocks.iter_mut().zip(firsts) {
+            *b = colouring.block(first);
+        }
+        let steps = blocks.iter().map(|b| b.len()).max().unwrap_or(0);
+        for s in 0..steps {
+            for b in &blocks {
+                if s < b.len() {
+                    project_tet(b.start + s);
                 }
             }
         }
     };
     if pool.threads() == 1 || model.tets.len() < MIN_PARALLEL_TETS {
-        colouring.blocks.iter().for_each(|&b| project(b));
+        colouring
+            .colours()
+            .for_each(|colour| colour.chunks(INTERLEAVED_BLOCKS).for_each(project));
         return;
     }
     let barrier = Barrier::new(pool.threads());
@@ -52,7 +73,7 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
         let _guard = barrier.guard();
         for colour in colouring.colours() {
             let mine = pool.share(share, colour.len());
-            colour[mine].iter().for_each(|&t| project(t));
+            colour[mine].chunks(INTERLEAVED_BLOCKS).for_each(project);
             barrier.wait();
         }
     });

@@ -20,7 +20,7 @@ pub(crate) struct StepScratch {
     /// Per-particle sums of their pair forces (N), for the multi-threaded force pass.
     pub(crate) own_force: Vec<Vec3>,
     /// XPBD multipliers of the volume constraints within a substep, one per load-time
-    /// tetrahedron (a cut body uses the first ones).
+    /// tetrahedron, in the colouring's projection order (a cut body uses the first ones).
     pub(crate) tet_lambda: Vec<Real>,
 }
 
