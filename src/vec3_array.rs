@@ -40,15 +40,6 @@ impl Vec3Array {
     pub fn iter_range(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = Vec3> + '_ {
         range.map(move |e| self.get(e))
     }
-    /// The components of the vectors of `range`.
-    #[inline]
-    pub fn slices(&self, range: std::ops::Range<usize>) -> Vec3Slices<'_> {
-        Vec3Slices {
-            x: &self.x[range.clone()],
-            y: &self.y[range.clone()],
-            z: &self.z[range],
-        }
-    }
     /// Overwrite with `other` (of the same length).
     pub fn copy_from(&mut self, other: &Vec3Array) {
         self.x.copy_from_slice(&other.x);
@@ -59,17 +50,6 @@ impl Vec3Array {
     pub fn heap_bytes(&self) -> usize {
         3 * std::mem::size_of_val(self.x.as_slice())
     }
-}
-
-/// The component slices of a run of vectors of a [`Vec3Array`].
-#[derive(Debug, Clone, Copy)]
-pub struct Vec3Slices<'a> {
-    /// First components.
-    pub x: &'a [Real],
-    /// Second components.
-    pub y: &'a [Real],
-    /// Third components.
-    pub z: &'a [Real],
 }
 
 #[cfg(test)]
