@@ -159,6 +159,7 @@ pub(crate) fn project_tool_surface(
         residual.reserve(body.model.boundary.len());
     }
     // Broad phase, once: the triangles with a free corner near the tool's path.
+    let path = PathBox::new(&prev.position, &cur.position, reach);
     for (t, triangle) in body.model.boundary.iter().enumerate() {
         let corners = triangle.map(|k| k as usize);
         if corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
@@ -166,6 +167,9 @@ pub(crate) fn project_tool_surface(
         }
         let [a, b, c] = corners.map(|k| predicted.p[k]);
         let centroid = (a + b + c) / 3.0;
+        if !path.may_reach(&centroid, [&a, &b, &c]) {
+            continue;
+        }
         let extent = [a, b, c]
             .iter()
             .map(|q| (q - centroid).norm())
@@ -413,6 +417,36 @@ fn distance_to_segment(point: &Vec3, a: &Vec3, b: &Vec3) -> Real {
     (point - (a + ab * s)).norm()
 }
 
+/// The bounding box of a tool's path in a substep, a segment (m), and the tool's reach (m): a
+/// quick first test of the broad phase, which spends no square root on the triangles far away.
+struct PathBox {
+    lo: Vec3,
+    hi: Vec3,
+    reach: Real,
+}
+
+impl PathBox {
+    fn new(from: &Vec3, to: &Vec3, reach: Real) -> Self {
+        PathBox {
+            lo: from.inf(to),
+            hi: from.sup(to),
+            reach,
+        }
+    }
+
+    /// False only for a triangle (corners `a b c`, centroid `centroid`) whose centroid is
+    /// farther than `reach` plus the triangle's extent from the segment (the broad phase's exact
+    /// test). The extent (largest distance of a corner from the centroid) is at most the
+    /// diagonal of the corners' box, at most the sum of its sides; a point that close to the
+    /// segment is that close to its box along each axis.
+    fn may_reach(&self, centroid: &Vec3, [a, b, c]: [&Vec3; 3]) -> bool {
+        let (lo, hi) = (a.inf(b).inf(c), a.sup(b).sup(c));
+        let side = hi - lo;
+        let margin = self.reach + side.x + side.y + side.z;
+        (0..3).all(|k| centroid[k] >= self.lo[k] - margin && centroid[k] <= self.hi[k] + margin)
+    }
+}
+
 /// Barycentric weights of `q` (a point on the triangle `a b c`), clamped to the triangle.
 fn barycentric(q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> [Real; 3] {
     let (e1, e2, d) = (b - a, c - a, q - a);
@@ -432,6 +466,51 @@ fn barycentric(q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> [Real; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The path box's quick test keeps every triangle the exact test keeps, and still turns
+    /// away most of those far from the path: random slivers and segments, near and far.
+    #[test]
+    fn the_path_box_rejects_only_triangles_out_of_reach() {
+        let mut seed = 7_u64;
+        let mut random = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        let mut point = |scale: Real| Vec3::new(random(), random(), random()) * scale;
+        let (mut kept, mut rejected) = (0, 0);
+        for case in 0..20_000 {
+            let (from, to) = (point(1.0), point(1.0));
+            let reach = 0.1 * (case % 4) as Real;
+            // Half the triangles next to a point of the path, half anywhere around it.
+            let along = from + (to - from) * (point(1.0).x + 0.5);
+            let centre = along + point(if case % 2 == 0 { 0.5 } else { 3.0 });
+            // Every fourth triangle a sliver along one axis, the worst case of the box.
+            let thin = if case % 4 == 0 { 1.0e-3 } else { 1.0 };
+            let squash = Vec3::new(1.0, thin, thin);
+            let [a, b, c] = [0; 3].map(|_| centre + point(0.1).component_mul(&squash));
+            let centroid = (a + b + c) / 3.0;
+            let extent = [a, b, c]
+                .iter()
+                .map(|q| (q - centroid).norm())
+                .fold(0.0, Real::max);
+            let exact = distance_to_segment(&centroid, &from, &to) <= reach + extent;
+            let quick = PathBox::new(&from, &to, reach).may_reach(&centroid, [&a, &b, &c]);
+            assert!(quick || !exact, "case {case}: a triangle in reach rejected");
+            kept += usize::from(exact);
+            rejected += usize::from(!quick);
+        }
+        let far = 20_000 - kept;
+        assert!(
+            kept > 1_000,
+            "{kept} triangles in reach: the cases test little"
+        );
+        assert!(
+            rejected * 2 > far,
+            "only {rejected} of {far} far triangles rejected"
+        );
+    }
 
     #[test]
     fn barycentric_weights_rebuild_the_point_and_sum_to_one() {
