@@ -162,14 +162,11 @@ pub(crate) fn project_tool_surface(
     let path = PathBox::new(&prev.position, &cur.position, reach);
     for (t, triangle) in body.model.boundary.iter().enumerate() {
         let corners = triangle.map(|k| k as usize);
-        if corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
-            continue;
-        }
         let [a, b, c] = corners.map(|k| predicted.p[k]);
-        let centroid = (a + b + c) / 3.0;
-        if !path.may_reach(&centroid, [&a, &b, &c]) {
+        if !path.may_reach([&a, &b, &c]) || corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
             continue;
         }
+        let centroid = (a + b + c) / 3.0;
         let extent = [a, b, c]
             .iter()
             .map(|q| (q - centroid).norm())
@@ -418,7 +415,8 @@ fn distance_to_segment(point: &Vec3, a: &Vec3, b: &Vec3) -> Real {
 }
 
 /// The bounding box of a tool's path in a substep, a segment (m), and the tool's reach (m): a
-/// quick first test of the broad phase, which spends no square root on the triangles far away.
+/// quick first test of the broad phase, which spends no division or square root on the
+/// triangles far away.
 struct PathBox {
     lo: Vec3,
     hi: Vec3,
@@ -434,16 +432,21 @@ impl PathBox {
         }
     }
 
-    /// False only for a triangle (corners `a b c`, centroid `centroid`) whose centroid is
-    /// farther than `reach` plus the triangle's extent from the segment (the broad phase's exact
-    /// test). The extent (largest distance of a corner from the centroid) is at most the
-    /// diagonal of the corners' box, at most the sum of its sides; a point that close to the
-    /// segment is that close to its box along each axis.
-    fn may_reach(&self, centroid: &Vec3, [a, b, c]: [&Vec3; 3]) -> bool {
-        let (lo, hi) = (a.inf(b).inf(c), a.sup(b).sup(c));
-        let side = hi - lo;
-        let margin = self.reach + side.x + side.y + side.z;
-        (0..3).all(|k| centroid[k] >= self.lo[k] - margin && centroid[k] <= self.hi[k] + margin)
+    /// False only for a triangle (corners `a b c`) whose centroid is farther than `reach` plus
+    /// the triangle's extent from the segment (the broad phase's exact test). The extent
+    /// (largest distance of a corner from the centroid) is at most the diagonal of the corners'
+    /// box, at most the sum of its sides; a centroid that close to the segment is that close to
+    /// the path's box along each axis, and the centroid lies in the corners' box, so that box
+    /// overlaps the path's box widened by the margin. (Plain comparisons: a NaN corner, which
+    /// the exact test never keeps, may go either way.)
+    #[inline]
+    fn may_reach(&self, [a, b, c]: [&Vec3; 3]) -> bool {
+        let lower = |x: Real, y: Real| if x < y { x } else { y };
+        let upper = |x: Real, y: Real| if x > y { x } else { y };
+        let lo = [0, 1, 2].map(|k| lower(lower(a[k], b[k]), c[k]));
+        let hi = [0, 1, 2].map(|k| upper(upper(a[k], b[k]), c[k]));
+        let margin = self.reach + (hi[0] - lo[0]) + (hi[1] - lo[1]) + (hi[2] - lo[2]);
+        (0..3).all(|k| hi[k] >= self.lo[k] - margin && lo[k] <= self.hi[k] + margin)
     }
 }
 
@@ -496,7 +499,7 @@ mod tests {
                 .map(|q| (q - centroid).norm())
                 .fold(0.0, Real::max);
             let exact = distance_to_segment(&centroid, &from, &to) <= reach + extent;
-            let quick = PathBox::new(&from, &to, reach).may_reach(&centroid, [&a, &b, &c]);
+            let quick = PathBox::new(&from, &to, reach).may_reach([&a, &b, &c]);
             assert!(quick || !exact, "case {case}: a triangle in reach rejected");
             kept += usize::from(exact);
             rejected += usize::from(!quick);
