@@ -6,7 +6,7 @@
 //! every build gives the same bits. Only [`F4::sum`] crosses lanes, in a fixed order.
 
 use crate::math::{Mat3, Real, Vec3};
-use std::ops::{Add, AddAssign, Mul, Sub};
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 use wide::f64x4;
 
 /// Lane count.
@@ -69,6 +69,23 @@ impl Mul for F4 {
     }
 }
 
+impl Div for F4 {
+    type Output = F4;
+    #[inline(always)]
+    fn div(self, o: F4) -> F4 {
+        F4(self.0 / o.0)
+    }
+}
+
+/// The sign bit flipped, as scalar negation does (`0 - x` would give `+0` for `x = +0`).
+impl Neg for F4 {
+    type Output = F4;
+    #[inline(always)]
+    fn neg(self) -> F4 {
+        F4(self.0 ^ f64x4::splat(-0.0))
+    }
+}
+
 impl AddAssign for F4 {
     #[inline(always)]
     fn add_assign(&mut self, o: F4) {
@@ -102,6 +119,24 @@ impl V4 {
             x: F4::new([a.x, b.x, c.x, d.x]),
             y: F4::new([a.y, b.y, c.y, d.y]),
             z: F4::new([a.z, b.z, c.z, d.z]),
+        }
+    }
+    /// Lane `l` is `a[l]`.
+    #[inline(always)]
+    pub(crate) fn from_vectors(a: &[Vec3; LANES]) -> V4 {
+        V4 {
+            x: F4::new([a[0].x, a[1].x, a[2].x, a[3].x]),
+            y: F4::new([a[0].y, a[1].y, a[2].y, a[3].y]),
+            z: F4::new([a[0].z, a[1].z, a[2].z, a[3].z]),
+        }
+    }
+    /// Lane-wise cross product, each component computed as nalgebra computes it.
+    #[inline(always)]
+    pub(crate) fn cross(&self, o: &V4) -> V4 {
+        V4 {
+            x: self.y * o.z - self.z * o.y,
+            y: self.z * o.x - self.x * o.z,
+            z: self.x * o.y - self.y * o.x,
         }
     }
     /// Lane-wise dot product.
@@ -153,6 +188,18 @@ impl Sub for V4 {
             x: self.x - o.x,
             y: self.y - o.y,
             z: self.z - o.z,
+        }
+    }
+}
+
+impl Neg for V4 {
+    type Output = V4;
+    #[inline(always)]
+    fn neg(self) -> V4 {
+        V4 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
         }
     }
 }

@@ -1,5 +1,6 @@
 //! XPBD tetrahedral volume constraint (eq. 13 of the paper): `C = V(p1..p4) - V0 = 0`.
 
+use crate::lanes::{F4, LANES, V4};
 use crate::math::{Real, Vec3};
 
 /// The projection of one tetrahedron's volume constraint.
@@ -46,10 +47,109 @@ pub fn volume_tet_correction(
     Some(dp)
 }
 
+/// [`volume_tet_correction`] for four tetrahedra at once, one a lane, with the same
+/// arguments by lane (`p`, `w`, `rest_volume`, `alpha_tilde`, `lambda`; `lambda` is not
+/// updated: the result holds its change).
+///
+/// Lane-wise IEEE operations in the order of the scalar formula (no fused multiply–add), so
+/// each lane gives the bits of [`volume_tet_correction`] for its tetrahedron.
+#[inline(always)]
+pub(crate) fn volume_tet_corrections4(
+    [pa, pb, pc, pd]: [V4; 4],
+    [wa, wb, wc, wd]: [F4; 4],
+    rest_volume: F4,
+    alpha_tilde: F4,
+    lambda: F4,
+) -> TetCorrections4 {
+    let (e1, e2, e3) = (pb - pa, pc - pa, pd - pa);
+    let sixth = F4::splat(1.0 / 6.0);
+    let g1 = e2.cross(&e3).scale(sixth);
+    let g2 = e3.cross(&e1).scale(sixth);
+    let g3 = e1.cross(&e2).scale(sixth);
+    let g0 = -(g1 + g2 + g3);
+    let denom =
+        wa * g0.dot(&g0) + wb * g1.dot(&g1) + wc * g2.dot(&g2) + wd * g3.dot(&g3) + alpha_tilde;
+    let c_value = e1.dot(&g1) - rest_volume;
+    let dl = (-c_value - alpha_tilde * lambda) / denom;
+    let mut out = TetCorrections4 {
+        moves: [false; LANES],
+        dl: dl.to_array(),
+        dp: [[Vec3::zeros(); LANES]; 4],
+    };
+    g0.scale(wa * dl).store(&mut out.dp[0]);
+    g1.scale(wb * dl).store(&mut out.dp[1]);
+    g2.scale(wc * dl).store(&mut out.dp[2]);
+    g3.scale(wd * dl).store(&mut out.dp[3]);
+    let denom = denom.to_array();
+    for (moves, denom) in out.moves.iter_mut().zip(denom) {
+        // A NaN denominator moves, as in the scalar formula (and the step reports the
+        // divergence).
+        *moves = denom > Real::MIN_POSITIVE || denom.is_nan();
+    }
+    out
+}
+
+/// The result of [`volume_tet_corrections4`], by lane.
+pub(crate) struct TetCorrections4 {
+    /// Whether the lane's tetrahedron moves: false where no particle can move (the scalar
+    /// projection's `None`).
+    pub(crate) moves: [bool; LANES],
+    /// The change of each lane's multiplier `Δλ`.
+    pub(crate) dl: [Real; LANES],
+    /// `dp[c][l]`: the correction (m) of corner `c` of lane `l`'s tetrahedron.
+    pub(crate) dp: [[Vec3; LANES]; 4],
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::math::tet_volume;
+
+    /// Every lane of the four-lane projection gives the scalar projection's bits, whatever the
+    /// other lanes hold: soft and hard constraints, a partly and a fully fixed tetrahedron, an
+    /// inverted one, a non-zero multiplier.
+    #[test]
+    fn each_lane_gives_the_scalar_projection_bits() {
+        let p = [
+            Vec3::new(0.1, -0.2, 0.05),
+            Vec3::new(1.3, 0.1, -0.2),
+            Vec3::new(-0.1, 0.9, 0.3),
+            Vec3::new(0.2, 0.3, 0.7),
+        ];
+        let inverted = [p[1], p[0], p[2], p[3]];
+        let cases = [
+            (p, [1.0, 2.0, 0.5, 1.5], 0.2, 1e-3, 0.0),
+            (p, [0.0, 2.0, 0.0, 1.5], 0.2, 0.0, 0.01),
+            (p, [0.0; 4], 0.2, 0.0, 0.0),
+            (inverted, [1.0; 4], 0.15, 1e-4, -0.02),
+        ];
+        for (case, &(p, w, v0, alpha, lambda)) in cases.iter().enumerate() {
+            let mut updated = lambda;
+            let expected = volume_tet_correction(p, w, v0, alpha, &mut updated);
+            for lane in 0..LANES {
+                // The other lanes hold the other cases.
+                let at = |l: usize| cases[(case + l + LANES - lane) % cases.len()];
+                let corner = |c: usize| V4::from_vectors(&std::array::from_fn(|l| at(l).0[c]));
+                let lanes = |f: &dyn Fn(usize) -> Real| F4::new(std::array::from_fn(f));
+                let got = volume_tet_corrections4(
+                    [0, 1, 2, 3].map(corner),
+                    [0, 1, 2, 3].map(|c| lanes(&|l| at(l).1[c])),
+                    lanes(&|l| at(l).2),
+                    lanes(&|l| at(l).3),
+                    lanes(&|l| at(l).4),
+                );
+                let got = got.moves[lane].then(|| (got.dl[lane], got.dp.map(|d| d[lane])));
+                match (got, expected) {
+                    (Some((dl, dp)), Some(expected_dp)) => {
+                        assert_eq!(lambda + dl, updated, "case {case}, lane {lane}");
+                        assert_eq!(dp, expected_dp, "case {case}, lane {lane}");
+                    }
+                    (None, None) => {}
+                    _ => panic!("case {case}, lane {lane}: {got:?} against {expected:?}"),
+                }
+            }
+        }
+    }
 
     #[test]
     fn hard_constraint_restores_volume_of_a_single_tet() {

@@ -1,10 +1,13 @@
 //! The XPBD tetrahedron volume constraints of a body, one Gauss–Seidel pass in colour order
 //! (`crate::colouring`): the colours in sequence, the blocks of a colour (which share no
 //! particle) split over the thread pool, each block's tetrahedra in their order, four blocks
-//! interleaved. The result does not depend on the thread count.
+//! in lock-step, one a lane (`volume_tet_corrections4`). The blocks share no particle, so the
+//! result is that of projecting them one after the other, and it does not depend on the
+//! thread count.
 
 use crate::body::Body;
-use crate::constraints::volume::volume_tet_correction;
+use crate::constraints::volume::{volume_tet_correction, volume_tet_corrections4};
+use crate::lanes::{F4, LANES, V4};
 use crate::math::Real;
 use crate::parallel::{Barrier, Pool, SharedSlice};
 use crate::solver::StepScratch;
@@ -13,8 +16,8 @@ use crate::solver::StepScratch;
 /// barrier per colour) costs about as much as projecting a few hundred tetrahedra per colour.
 const MIN_PARALLEL_TETS: usize = 4096;
 
-/// Blocks of one colour projected in an interleaved sequence (see `project_volumes`).
-const INTERLEAVED_BLOCKS: usize = 4;
+/// Blocks of one colour projected together, one a lane (see `project_volumes`).
+const INTERLEAVED_BLOCKS: usize = LANES;
 
 /// One Gauss–Seidel pass over a body's tetrahedron volume constraints for a substep `h` (s),
 /// on its predicted positions in `scratch`. Each constraint's XPBD compliance is the body's
@@ -44,17 +47,47 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             }
         }
     };
-    // A few blocks of one colour interleaved, tetrahedron by tetrahedron: consecutive
-    // projections then touch different particles and overlap in the processor, where one
-    // block's tetrahedra in a row would each wait for the previous one's writes. The blocks
-    // share no particle, so the result is that of projecting them one after the other.
+    // Four blocks of one colour in lock-step, the s-th tetrahedron of each a lane, while all
+    // four have one; the rest interleaved tetrahedron by tetrahedron, so that consecutive
+    // projections touch different particles and overlap in the processor. The blocks share no
+    // particle, so the result is that of projecting them one after the other.
     let project = |firsts: &[u32]| {
         let mut blocks: [std::ops::Range<usize>; INTERLEAVED_BLOCKS] = Default::default();
         for (b, &first) in blocks.iter_mut().zip(firsts) {
             *b = colouring.block(first);
         }
+        let together = match firsts.len() {
+            LANES => blocks.iter().map(|b| b.len()).min().unwrap_or(0),
+            _ => 0,
+        };
+        for s in 0..together {
+            let t = each_lane(|l| blocks[l].start + s);
+            let k = each_lane(|l| colouring.tets[t[l]]);
+            // SAFETY: sixteen distinct particles (four of a tetrahedron, and the blocks share
+            // none) and four distinct multipliers, each held once.
+            let x = each_lane(|l| each_lane(|c| unsafe { p.element(k[l][c] as usize) }));
+            let multiplier = each_lane(|l| unsafe { lambda.element(t[l]) });
+            let corner = |c: usize| V4::from_vectors(&each_lane(|l| *x[l][c]));
+            let mass = |c: usize| F4::new(each_lane(|l| body.inv_mass[k[l][c] as usize]));
+            let v0 = F4::new(each_lane(|l| colouring.rest_volume[t[l]]));
+            let corrections = volume_tet_corrections4(
+                each_lane(corner),
+                each_lane(mass),
+                v0,
+                F4::splat(compliance_per_h2) * v0,
+                F4::new(each_lane(|l| *multiplier[l])),
+            );
+            for (l, (x, multiplier)) in x.into_iter().zip(multiplier).enumerate() {
+                if corrections.moves[l] {
+                    *multiplier += corrections.dl[l];
+                    for (c, x) in x.into_iter().enumerate() {
+                        *x += corrections.dp[c][l];
+                    }
+                }
+            }
+        }
         let steps = blocks.iter().map(|b| b.len()).max().unwrap_or(0);
-        for s in 0..steps {
+        for s in together..steps {
             for b in &blocks {
                 if s < b.len() {
                     project_tet(b.start + s);
@@ -77,4 +110,11 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             barrier.wait();
         }
     });
+}
+
+/// `[f(0), f(1), f(2), f(3)]`, always inlined (`array::map` and `from_fn` are not always, in a
+/// loop this hot).
+#[inline(always)]
+fn each_lane<T>(mut f: impl FnMut(usize) -> T) -> [T; LANES] {
+    [f(0), f(1), f(2), f(3)]
 }
