@@ -81,7 +81,8 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
 /// Up to `newton_iterations` warm-started iterations on the objective of Müller, Bender,
 /// Chentanez and Macklin (2016), gradient `g = Σ_c r_c × f_c`, with Newton steps
 /// `δ = H⁻¹ g`, `H = tr(G) I - sym(G)`, `G = F Rᵀ` (quadratic convergence: 1–3 iterations from
-/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|`. Where that does not
+/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|` or a step is shorter than
+/// `CONVERGED_NEWTON_STEP`. Where that does not
 /// converge (near a saddle of a strongly inverted `F`, where `H` is indefinite) the rotation is computed exactly
 /// from the SVD: `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
 ///
@@ -121,6 +122,9 @@ pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) -> Mat3 
         let dq = Quaternion::new(1.0, 0.5 * delta.x, 0.5 * delta.y, 0.5 * delta.z);
         let p = dq * q.into_inner();
         *q = Quat::new_unchecked(p * (1.0 / p.norm()));
+        if delta.norm_squared() < CONVERGED_NEWTON_STEP * CONVERGED_NEWTON_STEP {
+            return q.to_rotation_matrix().into_inner();
+        }
     }
     *q = rotation_from_svd(f);
     q.to_rotation_matrix().into_inner()
@@ -129,6 +133,15 @@ pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) -> Mat3 
 /// Convergence tolerance of the rotation extraction: the gradient `|g|` relative to `|F|`
 /// (a rotation error of about this many radians).
 pub const ROTATION_TOLERANCE: Real = 1.0e-10;
+
+/// A Newton step of the rotation extraction shorter than this (rad) ends it without another
+/// evaluation of the gradient. Newton's method converges quadratically here: the error left
+/// after a step of `|δ|` is about `C |δ|²`, with `C` of order one for a deformation gradient
+/// that is not nearly flat (the ratio of `|F|` to the Hessian's smallest eigenvalue), so below
+/// `ROTATION_TOLERANCE` with a margin of 100 in `C`. The evaluation it saves (rotation matrix
+/// and gradient) is a fifth of the extraction's cost, and the next step's first evaluation,
+/// warm-started from this rotation, checks it anyway.
+const CONVERGED_NEWTON_STEP: Real = 1.0e-6;
 
 /// The proper rotation maximising `tr(Rᵀ f)`, from the SVD of `f` (singular values sorted in
 /// decreasing order; the smallest one's direction flipped when `det(UVᵀ) < 0`).
@@ -760,6 +773,32 @@ mod tests {
             .map(|((a, b), v)| (a - b).dot(v))
             .sum();
         assert!(power < 0.0, "damping power {power} W");
+    }
+
+    /// The Newton iterations end on the rotation of the SVD (to the tolerance), whether they
+    /// stop on the gradient or on a short step: stretched, sheared and strongly compressed
+    /// gradients, from a cold start (identity) and from a start one degree off.
+    #[test]
+    fn extracted_rotations_match_the_svd() {
+        let turn = Quat::from_scaled_axis(Vec3::new(0.4, -0.3, 0.8));
+        let stretches = [
+            Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 1.0)),
+            Mat3::from_diagonal(&Vec3::new(1.3, 0.9, 0.8)),
+            Mat3::new(1.0, 0.4, 0.0, 0.0, 1.0, 0.2, 0.1, 0.0, 1.0),
+            Mat3::from_diagonal(&Vec3::new(0.2, 1.1, 0.9)),
+        ];
+        for (k, stretch) in stretches.iter().enumerate() {
+            let f = turn.to_rotation_matrix().into_inner() * stretch;
+            let expected = rotation_from_svd(&f);
+            let near = Quat::from_scaled_axis(Vec3::new(0.0, 0.0175, 0.0)) * expected;
+            for (start, name) in [(Quat::identity(), "cold"), (near, "warm")] {
+                let mut q = start;
+                let r = extract_rotation(&f, &mut q, 6);
+                let error = (r - expected.to_rotation_matrix().into_inner()).norm();
+                assert!(error < 1e-9, "stretch {k}, {name} start: error {error:e}");
+                assert!((q.to_rotation_matrix().into_inner() - r).norm() < 1e-15);
+            }
+        }
     }
 
     /// The rotation of an overflowing or underflowing deformation gradient returns, finite
