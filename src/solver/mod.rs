@@ -226,6 +226,7 @@ impl World {
                             motion,
                             max_correction,
                             it == 0,
+                            &self.pool,
                         ),
                         ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
                             tool,

@@ -31,6 +31,7 @@ use crate::body::Body;
 use crate::collision::tool::{Pose, Tool, ToolShape};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
+use crate::parallel::{Pool, SharedSlice};
 use crate::solver::{tool_motion_at, StepScratch};
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
@@ -61,6 +62,8 @@ pub(crate) const SURFACE_PASS_TOLERANCE: Real = 0.01;
 /// depth), its buffers reused from one query to the next, and the triangles near the tool.
 pub(crate) struct SurfaceScratch {
     epa: EPA,
+    /// Per boundary triangle: whether the broad phase keeps it (written on the pool).
+    near_flags: Vec<bool>,
     near: Vec<u32>,
     /// Penetration of each of `near` left by the depenetration cap (m): kept through the passes.
     residual: Vec<Real>,
@@ -100,6 +103,7 @@ impl Default for SurfaceScratch {
         }
         SurfaceScratch {
             epa,
+            near_flags: Vec::new(),
             near: Vec::new(),
             residual: Vec::new(),
         }
@@ -124,7 +128,9 @@ impl std::fmt::Debug for SurfaceScratch {
 /// most the tool's own motion along it plus `max_correction` (m), in up to
 /// [`MAX_SURFACE_PASSES`] passes (until the largest correction of a pass is below
 /// [`SURFACE_PASS_TOLERANCE`] skins), and accumulate the tool's impulse and moment; `count` adds
-/// the triangles in contact in the first pass to the tool's contact count.
+/// the triangles in contact in the first pass to the tool's contact count. The broad phase runs
+/// on `pool`, each thread flagging its range of triangles; the rest on the calling thread.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn project_tool_surface(
     surface: &mut SurfaceScratch,
     tool: &mut Tool,
@@ -133,6 +139,7 @@ pub(crate) fn project_tool_surface(
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
     count: bool,
+    pool: &Pool,
 ) {
     let iso = cur.isometry();
     let iso_prev = prev.isometry();
@@ -149,32 +156,46 @@ pub(crate) fn project_tool_surface(
     let map: &dyn SupportMap = shape.as_support_map().unwrap_or(&hull);
     let SurfaceScratch {
         epa,
+        near_flags,
         near,
         residual,
     } = surface;
+    let boundary = &body.model.boundary;
     near.clear();
     residual.clear();
-    if near.capacity() < body.model.boundary.len() {
-        near.reserve(body.model.boundary.len());
-        residual.reserve(body.model.boundary.len());
+    if near.capacity() < boundary.len() {
+        near.reserve(boundary.len());
+        residual.reserve(boundary.len());
     }
-    // Broad phase, once: the triangles with a free corner near the tool's path.
+    near_flags.resize(boundary.len(), false);
+    // Broad phase, once: the triangles with a free corner near the tool's path, flagged on the
+    // pool, then listed in order (the same list for any thread count).
     let path = PathBox::new(&prev.position, &cur.position, reach);
-    for (t, triangle) in body.model.boundary.iter().enumerate() {
-        let corners = triangle.map(|k| k as usize);
-        let [a, b, c] = corners.map(|k| predicted.p[k]);
+    let p = &predicted.p;
+    let near_path = |t: usize| {
+        let corners = boundary[t].map(|k| k as usize);
+        let [a, b, c] = corners.map(|k| p[k]);
         if !path.may_reach([&a, &b, &c]) || corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
-            continue;
+            return false;
         }
         let centroid = (a + b + c) / 3.0;
         let extent = [a, b, c]
             .iter()
             .map(|q| (q - centroid).norm())
             .fold(0.0, Real::max);
-        if distance_to_segment(&centroid, &prev.position, &cur.position) <= reach + extent {
-            near.push(t as u32);
-            residual.push(0.0);
+        distance_to_segment(&centroid, &prev.position, &cur.position) <= reach + extent
+    };
+    let flags = SharedSlice::new(near_flags);
+    pool.for_each_range(boundary.len(), &|range| {
+        // SAFETY: the shares' ranges are disjoint.
+        let mine = unsafe { flags.range(range.clone()) };
+        for (flag, t) in mine.iter_mut().zip(range) {
+            *flag = near_path(t);
         }
+    });
+    for (t, _) in near_flags.iter().enumerate().filter(|(_, &f)| f) {
+        near.push(t as u32);
+        residual.push(0.0);
     }
     // Gauss–Seidel passes over them until they agree: the triangles of a dent share particles
     // and undo part of each other's corrections.
