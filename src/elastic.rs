@@ -81,10 +81,10 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
 /// Up to `newton_iterations` warm-started iterations on the objective of Müller, Bender,
 /// Chentanez and Macklin (2016), gradient `g = Σ_c r_c × f_c`, with Newton steps
 /// `δ = H⁻¹ g`, `H = tr(G) I - sym(G)`, `G = F Rᵀ` (quadratic convergence: 1–3 iterations from
-/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|` or a step is shorter than
-/// `CONVERGED_NEWTON_STEP`. Where that does not
-/// converge (near a saddle of a strongly inverted `F`, where `H` is indefinite) the rotation is computed exactly
-/// from the SVD: `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
+/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|` or a step is shorter
+/// than `CONVERGED_NEWTON_STEP`. Where that does not converge (near a saddle of a strongly
+/// inverted `F`, where `H` is indefinite) the rotation is computed exactly from the SVD:
+/// `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
 ///
 /// Returns the rotation as a matrix.
 #[inline]
