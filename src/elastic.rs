@@ -5,8 +5,8 @@
 //! Per particle `i` with volume `v_i` (m³):
 //! 1. `F_i = I + Σ_j (x_ij - u_ij) d_ijᵀ` (= `Σ_j x_ij d_ijᵀ`, eq. 1–2, written in displacements
 //!    for round-off), see [`crate::neighbours`];
-//! 2. `R_i` = the rotation that maximises `tr(Rᵀ F_i)` over proper rotations, found by the
-//!    objective of Müller et al. (2016) with Newton steps, warm-started from the previous step. This is
+//! 2. `R_i` = the rotation that maximises `tr(Rᵀ F_i)` over proper rotations, found four
+//!    particles at a time by warm-started Newton steps, see [`crate::rotation`]. This is
 //!    `U diag(1, 1, det(UVᵀ)) Vᵀ` of the SVD `F = U Σ Vᵀ`: Irving et al.'s inversion handling
 //!    (one singular value negated when `F` is inverted);
 //! 3. first Piola–Kirchhoff stress of the corotated model (eq. 3, `P = U P̂ Vᵀ` with
@@ -30,7 +30,7 @@ use crate::lanes::{F4, LANES, M4, V4};
 use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
 use crate::parallel::{Pool, SharedSlice};
-use nalgebra::Quaternion;
+use crate::rotation::extract_rotations;
 use std::ops::Range;
 
 /// The constants of the elastic model of one body.
@@ -76,117 +76,14 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
     f
 }
 
-/// Set `q` to the rotation that maximises `tr(Rᵀ f)` over proper rotations.
-///
-/// Up to `newton_iterations` warm-started iterations on the objective of Müller, Bender,
-/// Chentanez and Macklin (2016), gradient `g = Σ_c r_c × f_c`, with Newton steps
-/// `δ = H⁻¹ g`, `H = tr(G) I - sym(G)`, `G = F Rᵀ` (quadratic convergence: 1–3 iterations from
-/// the previous step's rotation), until `|g| < ROTATION_TOLERANCE · |F|` or a step is shorter
-/// than `CONVERGED_NEWTON_STEP`. Where that does not converge (near a saddle of a strongly
-/// inverted `F`, where `H` is indefinite) the rotation is computed exactly from the SVD:
-/// `U diag(1, 1, det(UVᵀ)) Vᵀ`, Irving et al.'s choice.
-///
-/// Returns the rotation as a matrix.
-#[inline]
-pub fn extract_rotation(f: &Mat3, q: &mut Quat, newton_iterations: u32) -> Mat3 {
-    let tolerance2 = ROTATION_TOLERANCE * ROTATION_TOLERANCE * f.norm_squared().max(1.0e-30);
-    for _ in 0..newton_iterations {
-        let r = q.to_rotation_matrix().into_inner();
-        let mut g = Vec3::zeros();
-        for c in 0..3 {
-            g += r.column(c).cross(&f.column(c));
-        }
-        if g.norm_squared() < tolerance2 {
-            return r;
-        }
-        // Newton step δ = H⁻¹ g, H = tr(G) I - sym(G) (symmetric), by its adjugate when H is
-        // positive definite (Sylvester's criterion); otherwise fall back to the SVD.
-        let gm = f * r.transpose();
-        let t = gm.trace();
-        let (a, d, z) = (t - gm[(0, 0)], t - gm[(1, 1)], t - gm[(2, 2)]);
-        let b = -0.5 * (gm[(0, 1)] + gm[(1, 0)]);
-        let c = -0.5 * (gm[(0, 2)] + gm[(2, 0)]);
-        let e = -0.5 * (gm[(1, 2)] + gm[(2, 1)]);
-        let (m00, m01, m02) = (d * z - e * e, c * e - b * z, b * e - c * d);
-        let (m11, m12, m22) = (a * z - c * c, b * c - a * e, a * d - b * b);
-        let det = a * m00 + b * m01 + c * m02;
-        if a <= 0.0 || m22 <= 0.0 || det <= 0.0 {
-            break;
-        }
-        let delta = Vec3::new(
-            m00 * g.x + m01 * g.y + m02 * g.z,
-            m01 * g.x + m11 * g.y + m12 * g.z,
-            m02 * g.x + m12 * g.y + m22 * g.z,
-        ) / det;
-        // A rotation by ~|δ| about δ: the quaternion (1, δ/2), normalised; no trigonometry.
-        let dq = Quaternion::new(1.0, 0.5 * delta.x, 0.5 * delta.y, 0.5 * delta.z);
-        let p = dq * q.into_inner();
-        *q = Quat::new_unchecked(p * (1.0 / p.norm()));
-        if delta.norm_squared() < CONVERGED_NEWTON_STEP * CONVERGED_NEWTON_STEP {
-            return q.to_rotation_matrix().into_inner();
-        }
-    }
-    *q = rotation_from_svd(f);
-    q.to_rotation_matrix().into_inner()
-}
-
-/// Convergence tolerance of the rotation extraction: the gradient `|g|` relative to `|F|`
-/// (a rotation error of about this many radians).
-pub const ROTATION_TOLERANCE: Real = 1.0e-10;
-
-/// A Newton step of the rotation extraction shorter than this (rad) ends it without another
-/// evaluation of the gradient. Newton's method converges quadratically here: the error left
-/// after a step of `|δ|` is about `C |δ|²`, with `C` of order one for a deformation gradient
-/// that is not nearly flat (the ratio of `|F|` to the Hessian's smallest eigenvalue), so below
-/// `ROTATION_TOLERANCE` with a margin of 100 in `C`. The evaluation it saves (rotation matrix
-/// and gradient) is a fifth of the extraction's cost, and the next step's first evaluation,
-/// warm-started from this rotation, checks it anyway.
-const CONVERGED_NEWTON_STEP: Real = 1.0e-6;
-
-/// The proper rotation maximising `tr(Rᵀ f)`, from the SVD of `f` (singular values sorted in
-/// decreasing order; the smallest one's direction flipped when `det(UVᵀ) < 0`).
-/// A non-finite `f` (which the step reports as divergence) gives the identity.
-pub fn rotation_from_svd(f: &Mat3) -> Quat {
-    if !f.iter().all(|c| c.is_finite()) {
-        return Quat::identity();
-    }
-    let Some(svd) = f.try_svd(true, true, Real::EPSILON, 200) else {
-        return Quat::identity();
-    };
-    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return Quat::identity();
-    };
-    if (u * v_t).determinant() < 0.0 {
-        // nalgebra sorts singular values decreasingly: the last is the smallest.
-        let mut k = 0;
-        for c in 1..3 {
-            if svd.singular_values[c] < svd.singular_values[k] {
-                k = c;
-            }
-        }
-        u.column_mut(k).neg_mut();
-    }
-    let r = u * v_t;
-    if !r.iter().all(|c| c.is_finite()) {
-        return Quat::identity();
-    }
-    // `from_matrix` iterates without bound (a matrix that overflowed inside the SVD never
-    // converges: a hang); 100 iterations are plenty for the orthogonal `U Vᵀ`.
-    let rot = nalgebra::Rotation3::from_matrix_eps(
-        &r,
-        Real::EPSILON,
-        100,
-        nalgebra::Rotation3::identity(),
-    );
-    Quat::from_rotation_matrix(&rot)
-}
-
-/// First Piola–Kirchhoff stress (Pa) of the corotated model for deformation gradient `f` and
-/// its rotation `r` (eq. 3): `2μ (F - R) + λ tr(RᵀF - I) R`.
-#[inline]
-pub fn corotated_stress(f: &Mat3, r: &Mat3, lambda: Real, mu: Real) -> Mat3 {
-    let tr = (r.transpose() * f).trace() - 3.0;
-    (f - r) * (2.0 * mu) + r * (lambda * tr)
+/// First Piola–Kirchhoff stress (Pa) of the corotated model for deformation gradients `f` and
+/// their rotations `r`, lane-wise (eq. 3): `2μ (F - R) + λ tr(RᵀF - I) R`.
+#[inline(always)]
+fn corotated_stress(f: &M4, r: &M4, lambda: Real, mu: Real) -> M4 {
+    let tr = r.inner(f) - F4::splat(3.0);
+    f.sub(r)
+        .scale(F4::splat(2.0 * mu))
+        .add(&r.scale(F4::splat(lambda) * tr))
 }
 
 /// The inputs of [`accumulate_forces`].
@@ -293,14 +190,29 @@ fn scatter_pass(
     force: &mut [Vec3],
 ) {
     let nbr = pass.input.nbr;
-    let mut buffer = PairBuffer::new();
-    for (i, q) in rotation.iter_mut().enumerate() {
-        let pf = &mut pair_force[nbr.slots(i)];
-        let fi = particle_pair_forces(pass, i, q, &mut buffer, pf);
-        for (&j, g) in nbr.index[nbr.range(i)].iter().zip(pf.iter()) {
-            force[j as usize] -= g;
+    let mut buffer = BlockBuffer::new();
+    let mut own = [Vec3::zeros(); LANES];
+    for (block, q) in rotation.chunks_mut(LANES).enumerate() {
+        let particles = block * LANES..block * LANES + q.len();
+        let slots = nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize;
+        let own = &mut own[..q.len()];
+        block_pair_forces(
+            pass,
+            particles.start,
+            q,
+            &mut buffer,
+            &mut pair_force[slots],
+            own,
+        );
+        for (i, fi) in particles.zip(own.iter()) {
+            for (&j, g) in nbr.index[nbr.range(i)]
+                .iter()
+                .zip(&pair_force[nbr.slots(i)])
+            {
+                force[j as usize] -= g;
+            }
+            force[i] += fi;
         }
-        force[i] += fi;
     }
 }
 
@@ -316,17 +228,13 @@ fn keep_pass(
 ) {
     let nbr = pass.input.nbr;
     let first_pair = nbr.offsets[particles.start] as usize;
-    let mut buffer = PairBuffer::new();
-    for (k, i) in particles.enumerate() {
-        let slots = nbr.slots(i);
-        let local = slots.start - first_pair..slots.end - first_pair;
-        own[k] = particle_pair_forces(
-            pass,
-            i,
-            &mut rotation[k],
-            &mut buffer,
-            &mut pair_force[local],
-        );
+    let mut buffer = BlockBuffer::new();
+    let blocks = rotation.chunks_mut(LANES).zip(own.chunks_mut(LANES));
+    for (block, (q, own)) in blocks.enumerate() {
+        let first = particles.start + block * LANES;
+        let slots = nbr.offsets[first] as usize - first_pair
+            ..nbr.offsets[first + q.len()] as usize - first_pair;
+        block_pair_forces(pass, first, q, &mut buffer, &mut pair_force[slots], own);
     }
 }
 
@@ -421,10 +329,11 @@ mod avx512 {
     }
 }
 
-/// Pair data of one particle held between the passes of [`particle_pair_forces`], four pair
-/// slots a chunk: the current offsets `x_ij` (m) and hourglass residuals `ε_ij` (m).
-struct PairBuffer {
-    offset: [V4; MAX_CHUNKS],
+/// Pair data held between the passes of [`block_pair_forces`], four pair slots a chunk: the
+/// current offsets `x_ij` (m) of a block's particles, and the hourglass residuals `ε_ij` (m) of
+/// one particle.
+struct BlockBuffer {
+    offset: [V4; LANES * MAX_CHUNKS],
     residual: [V4; MAX_CHUNKS],
 }
 
@@ -432,10 +341,10 @@ struct PairBuffer {
 /// [`crate::neighbours::build`] accepts, padded.
 const MAX_CHUNKS: usize = MAX_FIXED_NEIGHBOURS.div_ceil(LANES);
 
-impl PairBuffer {
+impl BlockBuffer {
     fn new() -> Self {
-        PairBuffer {
-            offset: [V4::default(); MAX_CHUNKS],
+        BlockBuffer {
+            offset: [V4::default(); LANES * MAX_CHUNKS],
             residual: [V4::default(); MAX_CHUNKS],
         }
     }
@@ -499,28 +408,61 @@ impl<'a> PairChunks<'a> {
     }
 }
 
-/// Particle `i`'s part of the first pass: its deformation gradient, rotation (warm-started in
-/// `q`) and stress, the force `g_ij` on `i` of each of its pair slots written to `pair_force`
-/// (one entry per slot of `i`; zero for the padding), and their sum returned. Three passes over
-/// the slots of `i`, four at a time (see [`crate::lanes`]); a padding slot (neighbour `i`, zero
-/// rest data) adds nothing anywhere. Always inlined, so that [`Kernel`] compiles it into its
-/// copies.
+/// The first pass of the particles `first..first + rotation.len()` (a block of at most
+/// [`LANES`]): their deformation gradients, rotations (warm-started in `rotation`) and stresses,
+/// the force `g_ij` on `i` of each of their pair slots written to `pair_force` (the block's
+/// slots; zero for the padding), and each particle's sum in `own`.
+///
+/// Per particle, three passes over its slots, four at a time (see [`crate::lanes`]); the
+/// rotations and stresses of the block's particles in lanes, one a lane. A padding slot
+/// (neighbour `i`, zero rest data) adds nothing anywhere. Always inlined, so that [`Kernel`]
+/// compiles it into its copies.
 #[inline(always)]
-fn particle_pair_forces(
+fn block_pair_forces(
     pass: &ParticlePass<'_, '_>,
-    i: usize,
-    q: &mut Quat,
-    buffer: &mut PairBuffer,
+    first: usize,
+    rotation: &mut [Quat],
+    buffer: &mut BlockBuffer,
     pair_force: &mut [Vec3],
-) -> Vec3 {
+    own: &mut [Vec3],
+) {
     let (model, input) = (pass.model, pass.input);
     let nbr = input.nbr;
+    let particles = first..first + rotation.len();
+    let base = nbr.offsets[first] as usize;
+    let chunks = |i: usize| {
+        let s = nbr.slots(i);
+        (s.start - base) / LANES..(s.end - base) / LANES
+    };
+    let mut f = [Mat3::identity(); LANES];
+    let mut volume = [0.0; LANES];
+    for (l, i) in particles.clone().enumerate() {
+        f[l] = gradient_pass(input, i, &mut buffer.offset[chunks(i)]);
+        volume[l] = input.volume[i];
+    }
+    let f4 = M4::from_matrices(&f);
+    let r4 = extract_rotations(&f4, rotation, pass.rotation_iterations);
+    let stress = corotated_stress(&f4, &r4, model.lambda, model.mu).scale(F4::new(volume));
+    let pair_force = pair_force.as_chunks_mut::<LANES>().0;
+    for (l, i) in particles.enumerate() {
+        own[l] = pair_pass(
+            pass,
+            i,
+            (&f[l], &stress.lane(l)),
+            &buffer.offset[chunks(i)],
+            &mut buffer.residual,
+            &mut pair_force[chunks(i)],
+        );
+    }
+}
+
+/// Pass 1 of particle `i`: `F = I + Σ (x_ij - u_ij) d_ijᵀ` (dimensionless), keeping the
+/// offsets `x_ij` (m) of its slots in `offset` (one entry per chunk of four).
+#[inline(always)]
+fn gradient_pass(input: &ForceInputs<'_>, i: usize, offset: &mut [V4]) -> Mat3 {
+    let nbr = input.nbr;
     let rest = PairChunks::new(nbr, nbr.slots(i));
-    let chunks = rest.len();
-    let offset = &mut buffer.offset[..chunks];
-    let residual = &mut buffer.residual[..chunks];
-    let pair_force = &mut pair_force.as_chunks_mut::<LANES>().0[..chunks];
-    // Pass 1: F = I + Σ (x_ij - u_ij) d_ijᵀ, keeping x_ij for the next passes.
+    let offset = &mut offset[..rest.len()];
     let xi = V4::splat(&input.x[i]);
     let mut fsum = M4::default();
     for (k, o) in offset.iter_mut().enumerate() {
@@ -528,15 +470,34 @@ fn particle_pair_forces(
         *o = V4::gather(input.x, &c.j) - xi;
         fsum.add_outer(&(*o - c.u), &c.d);
     }
-    let f = fsum.sum() + Mat3::identity();
-    let r = extract_rotation(&f, q, pass.rotation_iterations);
+    fsum.sum() + Mat3::identity()
+}
+
+/// Passes 2 and 3 of particle `i`, given its deformation gradient and its stress times its
+/// volume `v_i P_i` (N·m) in `(f, stress)` and its offsets `x_ij` from pass 1: the force `g_ij`
+/// (N) of each pair slot written to `pair_force`, their sum returned.
+#[inline(always)]
+fn pair_pass(
+    pass: &ParticlePass<'_, '_>,
+    i: usize,
+    (f, stress): (&Mat3, &Mat3),
+    offset: &[V4],
+    residual: &mut [V4],
+    pair_force: &mut [[Vec3; LANES]],
+) -> Vec3 {
+    let (model, input) = (pass.model, pass.input);
+    let nbr = input.nbr;
+    let rest = PairChunks::new(nbr, nbr.slots(i));
+    let chunks = rest.len();
+    let (offset, residual) = (&offset[..chunks], &mut residual[..chunks]);
+    let pair_force = &mut pair_force[..chunks];
     let vi = input.volume[i];
     // Pass 2: hourglass residuals ε = F u - x_ij and Q = Σ c ε uᵀ; skipped without hourglass
     // control (ε then multiplies c = 0 below).
     let c_scale = F4::splat(model.hourglass * vi);
     let mut qsum = M4::default();
     if model.hourglass != 0.0 {
-        let fl = M4::splat(&f);
+        let fl = M4::splat(f);
         for (k, (o, eps)) in offset.iter().zip(residual.iter_mut()).enumerate() {
             let c = rest.get(k);
             *eps = fl.mul(&c.u) - *o;
@@ -546,7 +507,7 @@ fn particle_pair_forces(
         residual.fill(V4::default());
     }
     // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
-    let m = M4::splat(&(corotated_stress(&f, &r, model.lambda, model.mu) * vi + qsum.sum()));
+    let m = M4::splat(&(stress + qsum.sum()));
     let damping = model.damping_stiffness * model.p_wave_modulus() * vi;
     let vel_i = V4::splat(&input.v[i]);
     let mut fi = V4::default();
@@ -578,6 +539,7 @@ fn particle_pair_forces(
 mod tests {
     use super::*;
     use crate::neighbours::{build, SupportRadius};
+    use crate::rotation::rotation_from_svd;
 
     /// A jittered 5×4×4 block of points (m), with a deterministic pseudo-random jitter.
     fn jittered_block() -> Vec<Vec3> {
@@ -773,46 +735,5 @@ mod tests {
             .map(|((a, b), v)| (a - b).dot(v))
             .sum();
         assert!(power < 0.0, "damping power {power} W");
-    }
-
-    /// The Newton iterations end on the rotation of the SVD (to the tolerance), whether they
-    /// stop on the gradient or on a short step: stretched, sheared and strongly compressed
-    /// gradients, from a cold start (identity) and from a start one degree off.
-    #[test]
-    fn extracted_rotations_match_the_svd() {
-        let turn = Quat::from_scaled_axis(Vec3::new(0.4, -0.3, 0.8));
-        let stretches = [
-            Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 1.0)),
-            Mat3::from_diagonal(&Vec3::new(1.3, 0.9, 0.8)),
-            Mat3::new(1.0, 0.4, 0.0, 0.0, 1.0, 0.2, 0.1, 0.0, 1.0),
-            Mat3::from_diagonal(&Vec3::new(0.2, 1.1, 0.9)),
-        ];
-        for (k, stretch) in stretches.iter().enumerate() {
-            let f = turn.to_rotation_matrix().into_inner() * stretch;
-            let expected = rotation_from_svd(&f);
-            let near = Quat::from_scaled_axis(Vec3::new(0.0, 0.0175, 0.0)) * expected;
-            for (start, name) in [(Quat::identity(), "cold"), (near, "warm")] {
-                let mut q = start;
-                let r = extract_rotation(&f, &mut q, 6);
-                let error = (r - expected.to_rotation_matrix().into_inner()).norm();
-                assert!(error < 1e-9, "stretch {k}, {name} start: error {error:e}");
-                assert!((q.to_rotation_matrix().into_inner() - r).norm() < 1e-15);
-            }
-        }
-    }
-
-    /// The rotation of an overflowing or underflowing deformation gradient returns, finite
-    /// (the SVD fallback is bounded): moved here from the robustness tests when `elastic`
-    /// became crate-private.
-    #[test]
-    fn rotation_of_an_overflowing_deformation_gradient_returns_finite() {
-        for f in [
-            Mat3::from_element(1e300),
-            Mat3::new(1e300, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1e300),
-            Mat3::from_element(Real::MIN_POSITIVE),
-        ] {
-            let q = rotation_from_svd(&f);
-            assert!(q.coords.iter().all(|c| c.is_finite()), "{f}");
-        }
     }
 }

@@ -6,8 +6,8 @@
 //! every build gives the same bits. Only [`F4::sum`] crosses lanes, in a fixed order.
 
 use crate::math::{Mat3, Real, Vec3};
-use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
-use wide::f64x4;
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+use wide::{f64x4, CmpLe, CmpLt};
 
 /// Lane count.
 pub(crate) const LANES: usize = 4;
@@ -36,6 +36,26 @@ impl F4 {
     #[inline(always)]
     pub(crate) fn from_fn(f: impl FnMut(usize) -> Real) -> F4 {
         F4::new(std::array::from_fn(f))
+    }
+    /// Lane-wise square root (correctly rounded, as the scalar one).
+    #[inline(always)]
+    pub(crate) fn sqrt(self) -> F4 {
+        F4(self.0.sqrt())
+    }
+    /// Lane-wise maximum; where `self` is NaN, `o` (as the scalar `max`).
+    #[inline(always)]
+    pub(crate) fn max(self, o: F4) -> F4 {
+        F4(self.0.max(o.0))
+    }
+    /// The lanes where `self < o` (false where either is NaN).
+    #[inline(always)]
+    pub(crate) fn lt(self, o: F4) -> Mask4 {
+        Mask4(self.0.cmp_lt(o.0))
+    }
+    /// The lanes where `self <= o` (false where either is NaN).
+    #[inline(always)]
+    pub(crate) fn le(self, o: F4) -> Mask4 {
+        Mask4(self.0.cmp_le(o.0))
     }
     /// `(l0 + l1) + (l2 + l3)`.
     #[inline(always)]
@@ -90,6 +110,68 @@ impl AddAssign for F4 {
     #[inline(always)]
     fn add_assign(&mut self, o: F4) {
         *self = *self + o;
+    }
+}
+
+/// A true or false per lane, as the comparisons of [`F4`] give it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Mask4(f64x4);
+
+impl Mask4 {
+    /// Every lane `b`.
+    #[inline(always)]
+    pub(crate) fn splat(b: bool) -> Mask4 {
+        Mask4(f64x4::splat(if b { f64::from_bits(u64::MAX) } else { 0.0 }))
+    }
+    /// Lane `l` is `b[l]`.
+    #[inline(always)]
+    pub(crate) fn new(b: [bool; LANES]) -> Mask4 {
+        Mask4(f64x4::new(b.map(|b| {
+            if b {
+                f64::from_bits(u64::MAX)
+            } else {
+                0.0
+            }
+        })))
+    }
+    /// Whether any lane is true.
+    #[inline(always)]
+    pub(crate) fn any(self) -> bool {
+        self.0.any()
+    }
+    /// Whether lane `l` is true.
+    #[inline(always)]
+    pub(crate) fn lane(self, l: usize) -> bool {
+        self.0.move_mask() & (1 << l) != 0
+    }
+    /// Lane-wise `if self { t } else { f }`, the bits of `t` or `f` unchanged.
+    #[inline(always)]
+    pub(crate) fn select(self, t: F4, f: F4) -> F4 {
+        F4(self.0.blend(t.0, f.0))
+    }
+}
+
+impl BitAnd for Mask4 {
+    type Output = Mask4;
+    #[inline(always)]
+    fn bitand(self, o: Mask4) -> Mask4 {
+        Mask4(self.0 & o.0)
+    }
+}
+
+impl BitOr for Mask4 {
+    type Output = Mask4;
+    #[inline(always)]
+    fn bitor(self, o: Mask4) -> Mask4 {
+        Mask4(self.0 | o.0)
+    }
+}
+
+impl Not for Mask4 {
+    type Output = Mask4;
+    #[inline(always)]
+    fn not(self) -> Mask4 {
+        Mask4(!self.0)
     }
 }
 
@@ -151,6 +233,15 @@ impl V4 {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
+        }
+    }
+    /// Lane-wise `if mask { t } else { f }`.
+    #[inline(always)]
+    pub(crate) fn select(mask: Mask4, t: &V4, f: &V4) -> V4 {
+        V4 {
+            x: mask.select(t.x, f.x),
+            y: mask.select(t.y, f.y),
+            z: mask.select(t.z, f.z),
         }
     }
     /// Write vector `l` to `out[l]`.
@@ -228,6 +319,71 @@ impl M4 {
                 z: F4::splat(m[(r, 2)]),
             }),
         }
+    }
+    /// Lane `l` is `m[l]`.
+    #[inline(always)]
+    pub(crate) fn from_matrices(m: &[Mat3; LANES]) -> M4 {
+        M4 {
+            rows: [0, 1, 2].map(|r| V4 {
+                x: F4::new(m.map(|m| m[(r, 0)])),
+                y: F4::new(m.map(|m| m[(r, 1)])),
+                z: F4::new(m.map(|m| m[(r, 2)])),
+            }),
+        }
+    }
+    /// The matrix in lane `l`.
+    #[inline(always)]
+    pub(crate) fn lane(&self, l: usize) -> Mat3 {
+        let [r0, r1, r2] = self.rows.map(|r| [r.x, r.y, r.z].map(|c| c.to_array()[l]));
+        Mat3::new(
+            r0[0], r0[1], r0[2], r1[0], r1[1], r1[2], r2[0], r2[1], r2[2],
+        )
+    }
+    /// Column `c` (0, 1 or 2) of every lane.
+    #[inline(always)]
+    pub(crate) fn column(&self, c: usize) -> V4 {
+        let [r0, r1, r2] = &self.rows;
+        let pick = |r: &V4| [r.x, r.y, r.z][c];
+        V4 {
+            x: pick(r0),
+            y: pick(r1),
+            z: pick(r2),
+        }
+    }
+    /// Lane-wise `mask ? t : f`.
+    #[inline(always)]
+    pub(crate) fn select(mask: Mask4, t: &M4, f: &M4) -> M4 {
+        M4 {
+            rows: [0, 1, 2].map(|r| V4::select(mask, &t.rows[r], &f.rows[r])),
+        }
+    }
+    /// Every lane scaled by the lane's `s`.
+    #[inline(always)]
+    pub(crate) fn scale(&self, s: F4) -> M4 {
+        M4 {
+            rows: self.rows.map(|r| r.scale(s)),
+        }
+    }
+    /// Lane-wise `self - o`.
+    #[inline(always)]
+    pub(crate) fn sub(&self, o: &M4) -> M4 {
+        M4 {
+            rows: [0, 1, 2].map(|r| self.rows[r] - o.rows[r]),
+        }
+    }
+    /// Lane-wise `self + o`.
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &M4) -> M4 {
+        M4 {
+            rows: [0, 1, 2].map(|r| self.rows[r] + o.rows[r]),
+        }
+    }
+    /// Lane-wise Frobenius inner product `Σ_ab self_ab o_ab`, row by row.
+    #[inline(always)]
+    pub(crate) fn inner(&self, o: &M4) -> F4 {
+        let [a0, a1, a2] = &self.rows;
+        let [b0, b1, b2] = &o.rows;
+        a0.dot(b0) + a1.dot(b1) + a2.dot(b2)
     }
     /// Lane-wise `self += a bᵀ`.
     #[inline(always)]

@@ -44,6 +44,7 @@ pub(crate) mod neighbours;
 pub(crate) mod parallel;
 pub(crate) mod particle_order;
 pub mod render;
+pub(crate) mod rotation;
 pub(crate) mod settings;
 pub(crate) mod solver;
 pub(crate) mod stability;

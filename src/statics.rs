@@ -108,7 +108,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         Some(x) => (0..n)
             .map(|i| {
                 let f = crate::elastic::deformation_gradient(nbr, x, i);
-                crate::elastic::rotation_from_svd(&f)
+                crate::rotation::rotation_from_svd(&f)
                     .to_rotation_matrix()
                     .into_inner()
             })
@@ -470,7 +470,7 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error
     body.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
     for i in 0..x.len() {
         let f = crate::elastic::deformation_gradient(&body.model.nbr, &x, i);
-        body.state.rotation[i] = crate::elastic::rotation_from_svd(&f);
+        body.state.rotation[i] = crate::rotation::rotation_from_svd(&f);
     }
     Ok(StaticSolve {
         iterations,
