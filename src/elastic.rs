@@ -353,7 +353,7 @@ impl BlockBuffer {
 /// The rest data of four consecutive pair slots: neighbours `j`, rest offsets `u_ij` (m), MLS
 /// gradients `d_ij` (1/m) and hourglass weights `ŵ_ij / |u_ij|²` (1/m²).
 struct PairChunk {
-    j: [usize; LANES],
+    j: [u32; LANES],
     u: V4,
     d: V4,
     w: F4,
@@ -400,7 +400,7 @@ impl<'a> PairChunks<'a> {
             z: F4::new(c[2][k]),
         };
         PairChunk {
-            j: self.j[k].map(|j| j as usize),
+            j: self.j[k],
             u: v(&self.u),
             d: v(&self.d),
             w: F4::new(self.w[k]),

@@ -195,21 +195,28 @@ impl V4 {
     }
     /// `field[j[l]]` in lane `l`.
     #[inline(always)]
-    pub(crate) fn gather(field: &[Vec3], j: &[usize; LANES]) -> V4 {
-        let (a, b, c, d) = (&field[j[0]], &field[j[1]], &field[j[2]], &field[j[3]]);
-        V4 {
-            x: F4::new([a.x, b.x, c.x, d.x]),
-            y: F4::new([a.y, b.y, c.y, d.y]),
-            z: F4::new([a.z, b.z, c.z, d.z]),
-        }
+    pub(crate) fn gather(field: &[Vec3], j: &[u32; LANES]) -> V4 {
+        let at = |l: usize| &field[j[l] as usize];
+        V4::from_refs([at(0), at(1), at(2), at(3)])
     }
-    /// Lane `l` is `a[l]`.
+    /// Lane `l` is `*a[l]`: four masked loads and a transpose with AVX, otherwise one
+    /// component at a time.
     #[inline(always)]
-    pub(crate) fn from_vectors(a: &[Vec3; LANES]) -> V4 {
+    pub(crate) fn from_refs(a: [&Vec3; LANES]) -> V4 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        {
+            let [x, y, z] = avx::transpose_in(a);
+            V4 {
+                x: F4(x),
+                y: F4(y),
+                z: F4(z),
+            }
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
         V4 {
-            x: F4::new([a[0].x, a[1].x, a[2].x, a[3].x]),
-            y: F4::new([a[0].y, a[1].y, a[2].y, a[3].y]),
-            z: F4::new([a[0].z, a[1].z, a[2].z, a[3].z]),
+            x: F4::new(a.map(|v| v.x)),
+            y: F4::new(a.map(|v| v.y)),
+            z: F4::new(a.map(|v| v.z)),
         }
     }
     /// Lane-wise cross product, each component computed as nalgebra computes it.
@@ -244,12 +251,18 @@ impl V4 {
             z: mask.select(t.z, f.z),
         }
     }
-    /// Write vector `l` to `out[l]`.
+    /// Write vector `l` to `out[l]`: a transpose and three stores with AVX, otherwise one
+    /// component at a time.
     #[inline(always)]
     pub(crate) fn store(&self, out: &mut [Vec3; LANES]) {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = Vec3::new(x[l], y[l], z[l]);
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        avx::transpose_out([self.x.0, self.y.0, self.z.0], out);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+        {
+            let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+            for (l, o) in out.iter_mut().enumerate() {
+                *o = Vec3::new(x[l], y[l], z[l]);
+            }
         }
     }
     /// The sum of the four vectors.
@@ -299,6 +312,60 @@ impl AddAssign for V4 {
     #[inline(always)]
     fn add_assign(&mut self, o: V4) {
         *self = *self + o;
+    }
+}
+
+/// Moving four 3-vectors in and out of lanes with AVX shuffles (pure data movement: the same
+/// bits as component-by-component copies).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+mod avx {
+    use super::{Vec3, LANES};
+    use std::arch::x86_64::{
+        __m256d, _mm256_blend_pd, _mm256_maskload_pd, _mm256_permute2f128_pd, _mm256_set_epi64x,
+        _mm256_storeu_pd, _mm256_unpackhi_pd, _mm256_unpacklo_pd,
+    };
+    use wide::f64x4;
+
+    // `f64x4` is one `__m256d` in a build with AVX: the transmutes below only rename it.
+    const _: () = assert!(std::mem::size_of::<f64x4>() == std::mem::size_of::<__m256d>());
+
+    /// `[x, y, z]`: the first, second and third components of `v[0..4]` in lanes 0..4.
+    #[inline(always)]
+    pub(super) fn transpose_in(v: [&Vec3; LANES]) -> [f64x4; 3] {
+        // SAFETY: AVX is enabled for the whole build (the cfg above). Each masked load reads
+        // the three components of a live `Vec3` (contiguous `f64`s); the fourth lane is masked
+        // off, so nothing past the vector is read.
+        unsafe {
+            let mask = _mm256_set_epi64x(0, -1, -1, -1);
+            let [a, b, c, d] = v.map(|v| _mm256_maskload_pd(v.as_ptr(), mask));
+            let ab_xz = _mm256_unpacklo_pd(a, b); // ax bx az bz
+            let ab_y = _mm256_unpackhi_pd(a, b); // ay by 0 0
+            let cd_xz = _mm256_unpacklo_pd(c, d);
+            let cd_y = _mm256_unpackhi_pd(c, d);
+            [
+                _mm256_permute2f128_pd(ab_xz, cd_xz, 0x20),
+                _mm256_permute2f128_pd(ab_y, cd_y, 0x20),
+                _mm256_permute2f128_pd(ab_xz, cd_xz, 0x31),
+            ]
+            .map(|m| std::mem::transmute::<__m256d, f64x4>(m))
+        }
+    }
+
+    /// Vector `l` of the lanes `[x, y, z]` written to `out[l]`.
+    #[inline(always)]
+    pub(super) fn transpose_out(lanes: [f64x4; 3], out: &mut [Vec3; LANES]) {
+        // SAFETY: AVX is enabled for the whole build. `out` is four `Vec3`s, twelve contiguous
+        // `f64`s: the three unaligned stores write exactly those.
+        unsafe {
+            let [x, y, z] = lanes.map(|l| std::mem::transmute::<f64x4, __m256d>(l));
+            let xy_even = _mm256_unpacklo_pd(x, y); // x0 y0 x2 y2
+            let yz_odd = _mm256_unpackhi_pd(y, z); // y1 z1 y3 z3
+            let zx = _mm256_blend_pd(z, x, 0b1010); // z0 x1 z2 x3
+            let p = out.as_mut_ptr() as *mut f64;
+            _mm256_storeu_pd(p, _mm256_permute2f128_pd(xy_even, zx, 0x20));
+            _mm256_storeu_pd(p.add(4), _mm256_blend_pd(yz_odd, xy_even, 0b1100));
+            _mm256_storeu_pd(p.add(8), _mm256_permute2f128_pd(zx, yz_odd, 0x31));
+        }
     }
 }
 
@@ -430,5 +497,26 @@ mod tests {
         // Pairwise, each 1 is rounded away against 1e16: 0. Left to right would give 1.
         assert_eq!(a.sum(), 0.0);
         assert_eq!(a * F4::splat(2.0) - a + F4::default(), a);
+    }
+
+    /// Gathering by index and storing move every component to its place, bit for bit,
+    /// the last vector of the field included (the loads must not read past it).
+    #[test]
+    fn gathered_and_stored_vectors_keep_their_components() {
+        let field: Vec<Vec3> = (0..7)
+            .map(|k| Vec3::new(k as Real + 0.25, -(k as Real) - 0.5, 1e-300 * k as Real))
+            .collect();
+        let j = [6, 0, 3, 6];
+        let v = V4::gather(&field, &j);
+        for (l, &k) in j.iter().enumerate() {
+            let lane = |c: F4| c.to_array()[l];
+            assert_eq!(
+                Vec3::new(lane(v.x), lane(v.y), lane(v.z)),
+                field[k as usize]
+            );
+        }
+        let mut out = [Vec3::zeros(); LANES];
+        v.store(&mut out);
+        assert_eq!(out, j.map(|k| field[k as usize]));
     }
 }

@@ -128,8 +128,10 @@ mod tests {
             let expected = volume_tet_correction(p, w, v0, alpha, &mut updated);
             for lane in 0..LANES {
                 // The other lanes hold the other cases.
-                let at = |l: usize| cases[(case + l + LANES - lane) % cases.len()];
-                let corner = |c: usize| V4::from_vectors(&std::array::from_fn(|l| at(l).0[c]));
+                let index = |l: usize| (case + l + LANES - lane) % cases.len();
+                let at = |l: usize| cases[index(l)];
+                let corner =
+                    |c: usize| V4::from_refs(std::array::from_fn(|l| &cases[index(l)].0[c]));
                 let lanes = |f: &dyn Fn(usize) -> Real| F4::new(std::array::from_fn(f));
                 let got = volume_tet_corrections4(
                     [0, 1, 2, 3].map(corner),

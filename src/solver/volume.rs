@@ -67,7 +67,7 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             // none) and four distinct multipliers, each held once.
             let x = each_lane(|l| each_lane(|c| unsafe { p.element(k[l][c] as usize) }));
             let multiplier = each_lane(|l| unsafe { lambda.element(t[l]) });
-            let corner = |c: usize| V4::from_vectors(&each_lane(|l| *x[l][c]));
+            let corner = |c: usize| V4::from_refs(each_lane(|l| &*x[l][c]));
             let mass = |c: usize| F4::new(each_lane(|l| body.inv_mass[k[l][c] as usize]));
             let v0 = F4::new(each_lane(|l| colouring.rest_volume[t[l]]));
             let corrections = volume_tet_corrections4(
