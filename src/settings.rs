@@ -3,6 +3,9 @@
 
 use crate::math::{Real, Vec3};
 
+/// The most threads a world's step runs on ([`Settings::threads`]).
+pub(crate) const MAX_THREADS: usize = 64;
+
 /// How tool–tissue contact is detected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactMode {
@@ -203,7 +206,7 @@ impl Settings {
             self.max_depenetration_speed,
             "m/s",
         )?;
-        if !(1..=64).contains(&self.threads) {
+        if !(1..=MAX_THREADS as u32).contains(&self.threads) {
             return bad("threads must be in 1..=64");
         }
         if self.iterations == 0 {

@@ -40,11 +40,12 @@ pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
+use crate::divergence::ParticleScan;
 use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
 use crate::parallel::SharedSlice;
-use crate::settings::ContactMode;
+use crate::settings::{ContactMode, MAX_THREADS};
 use crate::world::{StepReport, World};
 use parry3d_f64::math::{Isometry, Point};
 
@@ -82,9 +83,11 @@ impl World {
         }
         let limits = self.settings.divergence;
         let failure = (self.bodies.iter().zip(&rollback.bodies))
+            .zip(&self.workspace.bodies)
             .enumerate()
-            .find_map(|(b, (body, before))| {
-                crate::divergence::diverged(body, &before.particles.x, &limits).map(|why| (b, why))
+            .find_map(|(b, ((body, before), scratch))| {
+                crate::divergence::diverged(body, &scratch.scan, &before.particles.x, &limits)
+                    .map(|why| (b, why))
             });
         if let Some((b, why)) = failure {
             // The whole state at the start of the step back: particles, grasps, needle holds.
@@ -254,24 +257,51 @@ impl World {
                 }
             }
         }
+        // The update, and on the last substep the particle half of the divergence check,
+        // one scan per share merged in share order.
         let inv_h = 1.0 / h;
-        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter()) {
+        let last = k == n;
+        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter_mut()) {
             let n = body.state.x.len();
+            let max_speed = crate::divergence::max_speed(body, &self.settings.divergence);
             let predicted = &scratch.p;
             let state = &mut body.state;
             let (position, velocity) = (
                 SharedSlice::new(&mut state.x),
                 SharedSlice::new(&mut state.v),
             );
-            self.pool.for_each_range(n, &|range| {
-                // SAFETY: the shares' ranges are disjoint.
-                let (x, v) =
-                    unsafe { (position.range(range.clone()), velocity.range(range.clone())) };
-                for ((p, x), v) in predicted[range].iter().zip(x).zip(v) {
+            let mut scans = [ParticleScan::EMPTY; MAX_THREADS];
+            let shared_scans = SharedSlice::new(&mut scans[..self.pool.threads()]);
+            self.pool.run(&|share| {
+                let range = self.pool.share(share, n);
+                // SAFETY: the shares' ranges are disjoint, and each writes its own scan.
+                let (x, v, scan) = unsafe {
+                    (
+                        position.range(range.clone()),
+                        velocity.range(range.clone()),
+                        shared_scans.element(share),
+                    )
+                };
+                let updated = predicted[range.clone()].iter().zip(x).zip(v).zip(range);
+                let update = |((p, x), v): ((&Vec3, &mut Vec3), &mut Vec3)| {
                     *v = (p - *x) * inv_h;
                     *x = *p;
+                };
+                if last {
+                    let mut mine = ParticleScan::EMPTY;
+                    for (((p, x), v), i) in updated {
+                        update(((p, &mut *x), &mut *v));
+                        mine.visit(i, x, v, max_speed);
+                    }
+                    *scan = mine;
+                } else {
+                    updated.for_each(|(pxv, _)| update(pxv));
                 }
             });
+            if last {
+                let shares = &scans[..self.pool.threads()];
+                scratch.scan = shares.iter().fold(ParticleScan::EMPTY, |a, b| a.then(b));
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::body_model::BodyModel;
 use crate::collision::hash_grid::HashGrid;
+use crate::divergence::ParticleScan;
 use crate::math::{Real, Vec3};
 use crate::solver::SurfaceScratch;
 use crate::world_state::WorldState;
@@ -22,6 +23,8 @@ pub(crate) struct StepScratch {
     /// XPBD multipliers of the volume constraints within a substep, one per load-time
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones).
     pub(crate) tet_lambda: Vec<Real>,
+    /// The particle half of the divergence check, made in the step's last update pass.
+    pub(crate) scan: ParticleScan,
 }
 
 impl StepScratch {
@@ -34,6 +37,7 @@ impl StepScratch {
             pair_force: vec![Vec3::zeros(); model.nbr.slot_count()],
             own_force: vec![Vec3::zeros(); n],
             tet_lambda: vec![0.0; model.tets.len()],
+            scan: ParticleScan::EMPTY,
         }
     }
 }
