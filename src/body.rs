@@ -10,7 +10,7 @@ use crate::elastic::{self, ElasticModel, ForceInputs};
 use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Mat3, Quat, Real, Vec3};
 use crate::neighbours::{self, Neighbourhoods};
-use crate::parallel::Pool;
+use crate::parallel::{Pool, SharedSlice};
 use crate::particle_order::ParticleOrder;
 use crate::settings::Settings;
 use std::sync::Arc;
@@ -575,18 +575,72 @@ impl Body {
 }
 
 /// Volume (m³) enclosed by the closed `boundary` (outward triangles) at positions `x`: the sum
-/// of the signed volumes of the tetrahedra it bounds.
+/// of the signed volumes of the tetrahedra it bounds. The triangles are summed in
+/// [`VOLUME_RUNS`] runs of near-equal length, each in order, then the runs' sums in order: the
+/// order [`volume_on`] keeps on any number of threads.
 pub(crate) fn volume_of(x: &[Vec3], boundary: &[[u32; 3]]) -> Real {
+    (0..VOLUME_RUNS).map(|k| volume_run(x, boundary, k)).sum()
+}
+
+/// [`volume_of`] with its runs shared among the threads of `pool`: the same bits.
+pub(crate) fn volume_on(pool: &Pool, x: &[Vec3], boundary: &[[u32; 3]]) -> Real {
+    let mut runs = [0.0; VOLUME_RUNS];
+    let shared = SharedSlice::new(&mut runs);
+    pool.run(&|share| {
+        let mine = pool.share(share, VOLUME_RUNS);
+        // SAFETY: the shares' ranges of runs are disjoint.
+        let out = unsafe { shared.range(mine.clone()) };
+        for (sum, k) in out.iter_mut().zip(mine) {
+            *sum = volume_run(x, boundary, k);
+        }
+    });
+    runs.iter().sum()
+}
+
+/// Runs of boundary triangles in a volume sum: enough for any thread count a world takes.
+const VOLUME_RUNS: usize = crate::settings::MAX_THREADS;
+
+/// Run `k` of the volume sum of [`volume_of`] (m³).
+fn volume_run(x: &[Vec3], boundary: &[[u32; 3]], k: usize) -> Real {
     let Some(&[o, ..]) = boundary.first() else {
         return 0.0;
     };
     // The divergence theorem about a point of the surface (small terms, little cancellation).
     let o = x[o as usize];
-    boundary
+    let n = boundary.len();
+    boundary[k * n / VOLUME_RUNS..(k + 1) * n / VOLUME_RUNS]
         .iter()
         .map(|t| {
             let [a, b, c] = t.map(|k| x[k as usize]);
             tet_volume(&o, &a, &b, &c)
         })
         .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The volume sum on the pool gives the bits of the one on the calling thread, for
+    /// boundaries shorter and longer than the number of runs.
+    #[test]
+    fn the_volume_on_the_pool_has_the_bits_of_the_serial_one() {
+        let x: Vec<Vec3> = (0..50)
+            .map(|i| {
+                let t = i as Real * 0.7;
+                Vec3::new(t.sin(), (1.3 * t).cos(), 0.01 * t * t)
+            })
+            .collect();
+        for triangles in [0, 1, 17, 64, 65, 1000] {
+            let boundary: Vec<[u32; 3]> = (0..triangles)
+                .map(|t| [t % 50, (7 * t + 3) % 50, (13 * t + 11) % 50])
+                .collect();
+            let serial = volume_of(&x, &boundary);
+            assert!(triangles < 2 || serial != 0.0);
+            for threads in [1, 2, 3] {
+                let pooled = volume_on(&Pool::new(threads), &x, &boundary);
+                assert_eq!(pooled.to_bits(), serial.to_bits(), "{triangles} triangles");
+            }
+        }
+    }
 }

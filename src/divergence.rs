@@ -76,10 +76,12 @@ impl ParticleScan {
 }
 
 /// Why `body` has diverged, or `None` when it is within `limits`; `scan` is the scan of all its
-/// particles in their state now, `before` holds its positions (m) at the start of the step.
+/// particles in their state now and `volume_ratio` its [`Body::volume_ratio`] (dimensionless),
+/// `before` holds its positions (m) at the start of the step.
 pub(crate) fn diverged(
     body: &Body,
     scan: &ParticleScan,
+    volume_ratio: Real,
     before: &[Vec3],
     limits: &DivergenceLimits,
 ) -> Option<String> {
@@ -106,7 +108,7 @@ pub(crate) fn diverged(
         ));
     }
     let (min_ratio, max_ratio) = limits.volume_ratio;
-    let ratio = body.volume_ratio();
+    let ratio = volume_ratio;
     let ratio_before = || volume_of(before, &body.model.boundary) / body.model.rest_volume;
     if (ratio < min_ratio && ratio < ratio_before())
         || (ratio > max_ratio && ratio > ratio_before())

@@ -38,6 +38,7 @@ mod workspace;
 pub(crate) use surface_contact::{SurfaceScratch, SURFACE_SKIN};
 pub(crate) use workspace::{StepScratch, Workspace};
 
+use crate::body::volume_on;
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
@@ -86,8 +87,16 @@ impl World {
             .zip(&self.workspace.bodies)
             .enumerate()
             .find_map(|(b, ((body, before), scratch))| {
-                crate::divergence::diverged(body, &scratch.scan, &before.particles.x, &limits)
-                    .map(|why| (b, why))
+                let volume = volume_on(&self.pool, &body.state.x, &body.model.boundary);
+                let ratio = volume / body.rest_volume();
+                crate::divergence::diverged(
+                    body,
+                    &scratch.scan,
+                    ratio,
+                    &before.particles.x,
+                    &limits,
+                )
+                .map(|why| (b, why))
             });
         if let Some((b, why)) = failure {
             // The whole state at the start of the step back: particles, grasps, needle holds.
