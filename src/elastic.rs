@@ -156,21 +156,56 @@ pub fn accumulate_forces(
         let particles = pool.share(share, n);
         // SAFETY: shares own disjoint particle ranges.
         let f = unsafe { forces.range(particles.clone()) };
-        for (k, j) in particles.enumerate() {
+        // Two particles at a time: each sum is a chain of dependent additions, and two
+        // chains side by side keep the adder busy. Each keeps its own order.
+        let split = |j: usize| {
             // Pairs of particles before j have indices below offsets[j].
             let incoming = nbr.incoming(j);
-            let before = incoming.partition_point(|&e| e < nbr.offsets[j]);
-            let mut fj = f[k];
-            for &e in &incoming[..before] {
-                fj -= pairs[e as usize];
+            incoming.split_at(incoming.partition_point(|&e| e < nbr.offsets[j]))
+        };
+        let first = particles.start;
+        for (k, two) in f.chunks_mut(2).enumerate() {
+            let j = first + 2 * k;
+            if let [f0, f1] = two {
+                let ((before0, after0), (before1, after1)) = (split(j), split(j + 1));
+                let mut sums = [*f0, *f1];
+                subtract_pairs(&mut sums, [before0, before1], pairs);
+                sums[0] += own[j];
+                sums[1] += own[j + 1];
+                subtract_pairs(&mut sums, [after0, after1], pairs);
+                [*f0, *f1] = sums;
+            } else {
+                let (before, after) = split(j);
+                let mut fj = two[0];
+                for &e in before {
+                    fj -= pairs[e as usize];
+                }
+                fj += own[j];
+                for &e in after {
+                    fj -= pairs[e as usize];
+                }
+                two[0] = fj;
             }
-            fj += own[j];
-            for &e in &incoming[before..] {
-                fj -= pairs[e as usize];
-            }
-            f[k] = fj;
         }
     });
+}
+
+/// `sums[s] -= pairs[e]` for the pairs `e` of `lists[s]` in order, the two lists side by side.
+#[inline(always)]
+fn subtract_pairs(sums: &mut [Vec3; 2], lists: [&[u32]; 2], pairs: &[Vec3]) {
+    let common = lists[0].len().min(lists[1].len());
+    let (head0, tail0) = lists[0].split_at(common);
+    let (head1, tail1) = lists[1].split_at(common);
+    for (&e0, &e1) in head0.iter().zip(head1) {
+        sums[0] -= pairs[e0 as usize];
+        sums[1] -= pairs[e1 as usize];
+    }
+    for &e in tail0 {
+        sums[0] -= pairs[e as usize];
+    }
+    for &e in tail1 {
+        sums[1] -= pairs[e as usize];
+    }
 }
 
 /// What every particle of a force pass needs besides its own arrays.
@@ -609,7 +644,7 @@ mod tests {
 
     /// The four-lane force pass is the exact negative gradient of the energy (central finite
     /// differences), on neighbourhoods whose sizes are not all multiples of four (the padded
-    /// lanes must add nothing), and the same bits on one and two threads.
+    /// lanes must add nothing), and the same bits on one, two and three threads.
     #[test]
     fn forces_are_the_negative_energy_gradient_on_any_neighbourhood_size() {
         let rest = jittered_block();
@@ -627,7 +662,9 @@ mod tests {
             v: &v,
         };
         let f = forces(&model, &input, 1);
+        // Three threads: shares of odd length (pass B takes particles two at a time).
         assert_eq!(f, forces(&model, &input, 2));
+        assert_eq!(f, forces(&model, &input, 3));
         let scale = f.iter().map(|g| g.norm()).fold(0.0, Real::max);
         let h = 1e-6;
         for i in [0, 7, 33, 79] {
