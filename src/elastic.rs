@@ -554,15 +554,11 @@ fn pair_pass(
             let len2 = o.dot(o);
             let rate = (V4::gather(input.v, &c.j) - vel_i).dot(o);
             let k2 = c.d.dot(&c.d);
-            let (len2, k2, rate) = (len2.to_array(), k2.to_array(), rate.to_array());
-            let s = F4::from_fn(|l| {
-                if len2[l] > 1.0e-30 {
-                    damping * k2[l] * rate[l] / len2[l]
-                } else {
-                    0.0
-                }
-            });
-            g += o.scale(s);
+            // Lanes of (nearly) coincident particles get no damping: their quotient (an
+            // infinity or a NaN) is computed but not selected.
+            let s = (F4::splat(damping) * k2 * rate) / len2;
+            let separated = F4::splat(1.0e-30).lt(len2);
+            g += o.scale(separated.select(s, F4::splat(0.0)));
         }
         g.store(&mut pair_force[k]);
         fi += g;

@@ -32,11 +32,6 @@ impl F4 {
     pub(crate) fn to_array(self) -> [Real; LANES] {
         self.0.to_array()
     }
-    /// Lane `l` is `f(l)`: lane-wise selections.
-    #[inline(always)]
-    pub(crate) fn from_fn(f: impl FnMut(usize) -> Real) -> F4 {
-        F4::new(std::array::from_fn(f))
-    }
     /// Lane-wise square root (correctly rounded, as the scalar one).
     #[inline(always)]
     pub(crate) fn sqrt(self) -> F4 {
