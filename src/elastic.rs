@@ -165,26 +165,16 @@ pub fn accumulate_forces(
         };
         let first = particles.start;
         for (k, two) in f.chunks_mut(2).enumerate() {
-            let j = first + 2 * k;
-            if let [f0, f1] = two {
-                let ((before0, after0), (before1, after1)) = (split(j), split(j + 1));
-                let mut sums = [*f0, *f1];
-                subtract_pairs(&mut sums, [before0, before1], pairs);
-                sums[0] += own[j];
-                sums[1] += own[j + 1];
-                subtract_pairs(&mut sums, [after0, after1], pairs);
-                [*f0, *f1] = sums;
-            } else {
-                let (before, after) = split(j);
-                let mut fj = two[0];
-                for &e in before {
-                    fj -= pairs[e as usize];
-                }
-                fj += own[j];
-                for &e in after {
-                    fj -= pairs[e as usize];
-                }
-                two[0] = fj;
+            // An odd share's last particle goes beside itself (the same sum twice).
+            let j = [first + 2 * k, first + 2 * k + two.len() - 1];
+            let [(before0, after0), (before1, after1)] = j.map(split);
+            let mut sums = [two[0], two[two.len() - 1]];
+            subtract_pairs(&mut sums, [before0, before1], pairs);
+            sums[0] += own[j[0]];
+            sums[1] += own[j[1]];
+            subtract_pairs(&mut sums, [after0, after1], pairs);
+            for (fj, sum) in two.iter_mut().zip(sums) {
+                *fj = sum;
             }
         }
     });
