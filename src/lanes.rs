@@ -113,11 +113,6 @@ impl AddAssign for F4 {
 pub(crate) struct Mask4(f64x4);
 
 impl Mask4 {
-    /// Every lane `b`.
-    #[inline(always)]
-    pub(crate) fn splat(b: bool) -> Mask4 {
-        Mask4(f64x4::splat(if b { f64::from_bits(u64::MAX) } else { 0.0 }))
-    }
     /// Lane `l` is `b[l]`.
     #[inline(always)]
     pub(crate) fn new(b: [bool; LANES]) -> Mask4 {

@@ -127,8 +127,8 @@ pub(crate) fn extract_rotations(f: &M4, q: &mut [Quat], newton_iterations: u32) 
         F4::splat(ROTATION_TOLERANCE * ROTATION_TOLERANCE) * f.inner(f).max(F4::splat(1.0e-30));
     // Lanes still iterating, lanes whose last step was short, lanes left to the SVD.
     let mut pending = Mask4::new(std::array::from_fn(|l| l < count));
-    let mut short = Mask4::splat(false);
-    let mut failed = Mask4::splat(false);
+    let mut short = Mask4::new([false; LANES]);
+    let mut failed = Mask4::new([false; LANES]);
     let mut rotation = M4::splat(&Mat3::identity());
     for iteration in 0..=newton_iterations {
         let r = quat.rotation_matrix();
