@@ -201,6 +201,7 @@ impl BodyModel {
             + size_of_val(n.support_radius.as_slice())
             + size_of_val(n.incoming_offsets.as_slice())
             + size_of_val(n.incoming.as_slice())
+            + size_of_val(n.sources.as_slice())
             + size_of_val(self.tet_colouring.tets.as_slice())
             + size_of_val(self.tet_colouring.rest_volume.as_slice())
             + size_of_val(self.tet_colouring.blocks.as_slice())

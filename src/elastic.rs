@@ -29,7 +29,8 @@
 use crate::lanes::{F4, LANES, M4, V4};
 use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
-use crate::parallel::{Pool, SharedSlice};
+use crate::pair_sums::{self, PassA, TrailingSums, TRAIL_WINDOW};
+use crate::parallel::{Barrier, Pool, SharedSlice};
 use crate::rotation::extract_rotations;
 use std::ops::Range;
 
@@ -108,7 +109,8 @@ pub struct ForceInputs<'a> {
 /// are scattered as they are computed. On several, the particles are split into ranges: pass A
 /// stores every `g_ij` and each `Σ_j g_ij`; pass B has each particle `j` sum what concerns it in
 /// exactly the order of the scatter — pairs from particles before `j`, its own sum, pairs from
-/// particles after `j` — so the result is bit-identical for any number of threads.
+/// particles after `j` — so the result is bit-identical for any number of threads. Pass B
+/// trails pass A within each share, the rest after a barrier ([`crate::pair_sums`]).
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_forces(
     model: &ElasticModel,
@@ -135,67 +137,41 @@ pub fn accumulate_forces(
     let rotation = SharedSlice::new(rotation);
     let pairs = SharedSlice::new(pair_force);
     let own = SharedSlice::new(own_force);
-    pool.run(&|share| {
-        let particles = pool.share(share, n);
-        let first_pair = nbr.offsets[particles.start] as usize;
-        let last_pair = nbr.offsets[particles.end] as usize;
-        // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
-        let (rot, pf, own) = unsafe {
-            (
-                rotation.range(particles.clone()),
-                pairs.range(first_pair..last_pair),
-                own.range(particles.clone()),
-            )
-        };
-        kernel.keep(&pass, particles, rot, pf, own);
-    });
-    // SAFETY: pass A has finished; pass B only reads these.
-    let (pairs, own) = unsafe { (pairs.range(0..nbr.slot_count()), own.range(0..n)) };
     let forces = SharedSlice::new(force);
+    let barrier = Barrier::new(pool.threads());
     pool.run(&|share| {
+        let _guard = barrier.guard();
         let particles = pool.share(share, n);
+        {
+            let first_pair = nbr.offsets[particles.start] as usize;
+            let last_pair = nbr.offsets[particles.end] as usize;
+            // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
+            let (rot, pf, own, f) = unsafe {
+                (
+                    rotation.range(particles.clone()),
+                    pairs.range(first_pair..last_pair),
+                    own.range(particles.clone()),
+                    forces.range(particles.clone()),
+                )
+            };
+            let mut sums = TrailingSums::new(nbr, particles.clone(), TRAIL_WINDOW, f);
+            kernel.keep(&pass, particles.clone(), rot, pf, own, &mut sums);
+        }
+        barrier.wait();
+        // SAFETY: every share's pass A has finished: its results are only read from here on;
+        // each share writes only its own particles' forces.
+        let pass_a = unsafe {
+            PassA {
+                pairs: pairs.read(0..nbr.slot_count()),
+                pair_base: 0,
+                own: own.read(0..n),
+                own_base: 0,
+            }
+        };
         // SAFETY: shares own disjoint particle ranges.
         let f = unsafe { forces.range(particles.clone()) };
-        // Two particles at a time: each sum is a chain of dependent additions, and two
-        // chains side by side keep the adder busy. Each keeps its own order.
-        let split = |j: usize| {
-            // Pairs of particles before j have indices below offsets[j].
-            let incoming = nbr.incoming(j);
-            incoming.split_at(incoming.partition_point(|&e| e < nbr.offsets[j]))
-        };
-        let first = particles.start;
-        for (k, two) in f.chunks_mut(2).enumerate() {
-            // An odd share's last particle goes beside itself (the same sum twice).
-            let j = [first + 2 * k, first + 2 * k + two.len() - 1];
-            let [(before0, after0), (before1, after1)] = j.map(split);
-            let mut sums = [two[0], two[two.len() - 1]];
-            subtract_pairs(&mut sums, [before0, before1], pairs);
-            sums[0] += own[j[0]];
-            sums[1] += own[j[1]];
-            subtract_pairs(&mut sums, [after0, after1], pairs);
-            for (fj, sum) in two.iter_mut().zip(sums) {
-                *fj = sum;
-            }
-        }
+        pair_sums::sum_after_barrier(nbr, particles, TRAIL_WINDOW, f, pass_a);
     });
-}
-
-/// `sums[s] -= pairs[e]` for the pairs `e` of `lists[s]` in order, the two lists side by side.
-#[inline(always)]
-fn subtract_pairs(sums: &mut [Vec3; 2], lists: [&[u32]; 2], pairs: &[Vec3]) {
-    let common = lists[0].len().min(lists[1].len());
-    let (head0, tail0) = lists[0].split_at(common);
-    let (head1, tail1) = lists[1].split_at(common);
-    for (&e0, &e1) in head0.iter().zip(head1) {
-        sums[0] -= pairs[e0 as usize];
-        sums[1] -= pairs[e1 as usize];
-    }
-    for &e in tail0 {
-        sums[0] -= pairs[e as usize];
-    }
-    for &e in tail1 {
-        sums[1] -= pairs[e as usize];
-    }
 }
 
 /// What every particle of a force pass needs besides its own arrays.
@@ -242,7 +218,8 @@ fn scatter_pass(
 }
 
 /// Pass A of several threads, one share: the pair forces of the particles `particles` kept in
-/// `pair_force` (their slots, from the first particle's) and their sums in `own`.
+/// `pair_force` (their slots, from the first particle's) and their sums in `own`, with the
+/// trailing pass B in `sums` (see [`crate::pair_sums`]).
 #[inline(always)]
 fn keep_pass(
     pass: &ParticlePass<'_, '_>,
@@ -250,16 +227,32 @@ fn keep_pass(
     rotation: &mut [Quat],
     pair_force: &mut [Vec3],
     own: &mut [Vec3],
+    sums: &mut TrailingSums<'_>,
 ) {
     let nbr = pass.input.nbr;
     let first_pair = nbr.offsets[particles.start] as usize;
     let mut buffer = BlockBuffer::new();
-    let blocks = rotation.chunks_mut(LANES).zip(own.chunks_mut(LANES));
-    for (block, (q, own)) in blocks.enumerate() {
+    for block in 0..rotation.len().div_ceil(LANES) {
         let first = particles.start + block * LANES;
-        let slots = nbr.offsets[first] as usize - first_pair
-            ..nbr.offsets[first + q.len()] as usize - first_pair;
-        block_pair_forces(pass, first, q, &mut buffer, &mut pair_force[slots], own);
+        let done = (first + LANES).min(particles.end);
+        let slots =
+            nbr.offsets[first] as usize - first_pair..nbr.offsets[done] as usize - first_pair;
+        let local = first - particles.start..done - particles.start;
+        block_pair_forces(
+            pass,
+            first,
+            &mut rotation[local.clone()],
+            &mut buffer,
+            &mut pair_force[slots],
+            &mut own[local],
+        );
+        let pass_a = PassA {
+            pairs: pair_force,
+            pair_base: first_pair,
+            own,
+            own_base: particles.start,
+        };
+        sums.advance(done, pass_a);
     }
 }
 
@@ -315,14 +308,15 @@ impl Kernel {
         rotation: &mut [Quat],
         pair_force: &mut [Vec3],
         own: &mut [Vec3],
+        sums: &mut TrailingSums<'_>,
     ) {
         match self {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `scatter`.
             Kernel::Avx512 => unsafe {
-                avx512::keep_pass(pass, particles, rotation, pair_force, own)
+                avx512::keep_pass(pass, particles, rotation, pair_force, own, sums)
             },
-            _ => keep_pass(pass, particles, rotation, pair_force, own),
+            _ => keep_pass(pass, particles, rotation, pair_force, own, sums),
         }
     }
 }
@@ -349,8 +343,9 @@ mod avx512 {
         rotation: &mut [Quat],
         pair_force: &mut [Vec3],
         own: &mut [Vec3],
+        sums: &mut TrailingSums<'_>,
     ) {
-        super::keep_pass(pass, particles, rotation, pair_force, own)
+        super::keep_pass(pass, particles, rotation, pair_force, own, sums)
     }
 }
 
@@ -708,8 +703,25 @@ mod tests {
             let mut kept_rotation = vec![Quat::identity(); n];
             let mut kept = vec![Vec3::zeros(); nbr.slot_count()];
             let mut own = vec![Vec3::zeros(); n];
-            kernel.keep(&pass, 0..n, &mut kept_rotation, &mut kept, &mut own);
+            let mut summed = vec![Vec3::zeros(); n];
+            let mut sums = TrailingSums::new(&nbr, 0..n, TRAIL_WINDOW, &mut summed);
+            kernel.keep(
+                &pass,
+                0..n,
+                &mut kept_rotation,
+                &mut kept,
+                &mut own,
+                &mut sums,
+            );
+            let pass_a = PassA {
+                pairs: &kept,
+                pair_base: 0,
+                own: &own,
+                own_base: 0,
+            };
+            pair_sums::sum_after_barrier(&nbr, 0..n, TRAIL_WINDOW, &mut summed, pass_a);
             assert_eq!(kept, pair_force);
+            assert_eq!(summed, force);
             (force, rotation, own)
         };
         let (force, rotation, own) = run(Kernel::Build);

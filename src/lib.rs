@@ -41,6 +41,7 @@ pub(crate) mod math;
 pub mod mesh;
 pub mod needle;
 pub(crate) mod neighbours;
+pub(crate) mod pair_sums;
 pub(crate) mod parallel;
 pub(crate) mod particle_order;
 pub mod render;

@@ -62,6 +62,10 @@ pub struct Neighbourhoods {
     pub incoming_offsets: Vec<u32>,
     /// Pair indices grouped by neighbour (see `incoming_offsets`).
     pub incoming: Vec<u32>,
+    /// `sources[j]`: the first and the last of the particles whose pairs particle `j`'s force
+    /// sum reads, the particles that have `j` as a neighbour and `j` itself (length:
+    /// particles). The multi-thread force pass sums `j` once they are done.
+    pub sources: Vec<[u32; 2]>,
 }
 
 impl Neighbourhoods {
@@ -139,6 +143,7 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
         support_radius: Vec::with_capacity(n),
         incoming_offsets: Vec::new(),
         incoming: Vec::new(),
+        sources: (0..n as u32).map(|j| [j, j]).collect(),
     };
     out.offsets.push(0);
     let mut candidates: Vec<(Real, u32)> = Vec::new();
@@ -241,6 +246,9 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
             let j = out.index[e] as usize;
             out.incoming[fill[j] as usize] = e as u32;
             fill[j] += 1;
+            let [first, last] = &mut out.sources[j];
+            *first = (*first).min(i as u32);
+            *last = (*last).max(i as u32);
         }
     }
     Ok(out)
@@ -403,8 +411,8 @@ mod tests {
     }
 
     /// Each particle's slots start on a chunk boundary and hold its pairs then at most three
-    /// inert padding slots (neighbour itself, zero rest data); the transposed lists and the
-    /// pair count see only the real pairs.
+    /// inert padding slots (neighbour itself, zero rest data); the transposed lists, the
+    /// sources and the pair count see only the real pairs.
     #[test]
     fn pair_slots_are_chunk_aligned_and_padding_is_inert() {
         let rest = jittered_lattice();
@@ -435,6 +443,7 @@ mod tests {
         assert_eq!(nbr.pair_count(), real);
         assert_eq!(nbr.slot_count(), real + padded);
         for j in 0..rest.len() {
+            let mut sources = [j, j];
             for &e in nbr.incoming(j) {
                 let e = e as usize;
                 let owner = (0..rest.len())
@@ -445,7 +454,9 @@ mod tests {
                     "padding slot {e} listed as incoming"
                 );
                 assert_eq!(nbr.index[e] as usize, j);
+                sources = [sources[0].min(owner), sources[1].max(owner)];
             }
+            assert_eq!(nbr.sources[j].map(|k| k as usize), sources, "particle {j}");
         }
     }
 }

@@ -200,6 +200,15 @@ impl<T> SharedSlice<T> {
         // SAFETY: in bounds (checked) and exclusive by the caller's contract.
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
     }
+    /// The elements `range`, shared.
+    ///
+    /// # Safety
+    /// No share may write any element of `range` while the result is in use.
+    pub unsafe fn read(&self, range: Range<usize>) -> &[T] {
+        assert!(range.start <= range.end && range.end <= self.len);
+        // SAFETY: in bounds (checked) and not written by the caller's contract.
+        unsafe { std::slice::from_raw_parts(self.ptr.add(range.start), range.len()) }
+    }
     /// Element `i`, mutable.
     ///
     /// # Safety
