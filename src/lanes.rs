@@ -255,6 +255,20 @@ impl V4 {
             }
         }
     }
+    /// Write vector `l` to `*out[l]`: a transpose and two stores a vector with AVX, otherwise
+    /// one component at a time.
+    #[inline(always)]
+    pub(crate) fn store_refs(&self, out: [&mut Vec3; LANES]) {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        avx::transpose_out_refs([self.x.0, self.y.0, self.z.0], out);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+        {
+            let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+            for (l, o) in out.into_iter().enumerate() {
+                *o = Vec3::new(x[l], y[l], z[l]);
+            }
+        }
+    }
     /// The sum of the four vectors.
     #[inline(always)]
     pub(crate) fn sum(&self) -> Vec3 {
@@ -311,8 +325,9 @@ impl AddAssign for V4 {
 mod avx {
     use super::{Vec3, LANES};
     use std::arch::x86_64::{
-        __m256d, _mm256_blend_pd, _mm256_maskload_pd, _mm256_permute2f128_pd, _mm256_set_epi64x,
-        _mm256_storeu_pd, _mm256_unpackhi_pd, _mm256_unpacklo_pd,
+        __m256d, _mm256_blend_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
+        _mm256_maskload_pd, _mm256_permute2f128_pd, _mm256_set_epi64x, _mm256_storeu_pd,
+        _mm256_unpackhi_pd, _mm256_unpacklo_pd, _mm_store_sd, _mm_storeu_pd,
     };
     use wide::f64x4;
 
@@ -355,6 +370,32 @@ mod avx {
             _mm256_storeu_pd(p, _mm256_permute2f128_pd(xy_even, zx, 0x20));
             _mm256_storeu_pd(p.add(4), _mm256_blend_pd(yz_odd, xy_even, 0b1100));
             _mm256_storeu_pd(p.add(8), _mm256_permute2f128_pd(zx, yz_odd, 0x31));
+        }
+    }
+
+    /// Vector `l` of the lanes `[x, y, z]` written to `*out[l]`.
+    #[inline(always)]
+    pub(super) fn transpose_out_refs(lanes: [f64x4; 3], out: [&mut Vec3; LANES]) {
+        // SAFETY: AVX is enabled for the whole build. Each pair of stores writes the three
+        // components of a live, exclusively borrowed `Vec3` (contiguous `f64`s), and nothing
+        // past them.
+        unsafe {
+            let [x, y, z] = lanes.map(|l| std::mem::transmute::<f64x4, __m256d>(l));
+            let xy_even = _mm256_unpacklo_pd(x, y); // x0 y0 x2 y2
+            let xy_odd = _mm256_unpackhi_pd(x, y); // x1 y1 x3 y3
+            let z_even = _mm256_unpacklo_pd(z, z); // z0 z0 z2 z2
+            let z_odd = _mm256_unpackhi_pd(z, z); // z1 z1 z3 z3
+            let vectors = [
+                _mm256_permute2f128_pd(xy_even, z_even, 0x20), // x0 y0 z0 z0
+                _mm256_permute2f128_pd(xy_odd, z_odd, 0x20),
+                _mm256_permute2f128_pd(xy_even, z_even, 0x31),
+                _mm256_permute2f128_pd(xy_odd, z_odd, 0x31),
+            ];
+            for (o, v) in out.into_iter().zip(vectors) {
+                let p = o.as_mut_ptr();
+                _mm_storeu_pd(p, _mm256_castpd256_pd128(v));
+                _mm_store_sd(p.add(2), _mm256_extractf128_pd(v, 1));
+            }
         }
     }
 }
@@ -489,8 +530,9 @@ mod tests {
         assert_eq!(a * F4::splat(2.0) - a + F4::default(), a);
     }
 
-    /// Gathering by index and storing move every component to its place, bit for bit,
-    /// the last vector of the field included (the loads must not read past it).
+    /// Gathering by index and storing (to an array or through references) move every
+    /// component to its place, bit for bit, the last vector of the field included (the loads
+    /// must not read past it), and nothing beside a target is written.
     #[test]
     fn gathered_and_stored_vectors_keep_their_components() {
         let field: Vec<Vec3> = (0..7)
@@ -508,5 +550,14 @@ mod tests {
         let mut out = [Vec3::zeros(); LANES];
         v.store(&mut out);
         assert_eq!(out, j.map(|k| field[k as usize]));
+        // Stored through references, the neighbours of each target untouched.
+        let mut targets = [Vec3::repeat(7.0); 2 * LANES + 1];
+        let [_, a, _, b, _, c, _, d, _] = &mut targets;
+        v.store_refs([d, b, a, c]);
+        let mut expected = [Vec3::repeat(7.0); 2 * LANES + 1];
+        for (t, l) in [7, 3, 1, 5].into_iter().zip([0, 1, 2, 3]) {
+            expected[t] = field[j[l] as usize];
+        }
+        assert_eq!(targets, expected);
     }
 }

@@ -1,6 +1,6 @@
 //! XPBD tetrahedral volume constraint (eq. 13 of the paper): `C = V(p1..p4) - V0 = 0`.
 
-use crate::lanes::{F4, LANES, V4};
+use crate::lanes::{Mask4, F4, V4};
 use crate::math::{Real, Vec3};
 
 /// The projection of one tetrahedron's volume constraint.
@@ -71,38 +71,35 @@ pub(crate) fn volume_tet_corrections4(
         wa * g0.dot(&g0) + wb * g1.dot(&g1) + wc * g2.dot(&g2) + wd * g3.dot(&g3) + alpha_tilde;
     let c_value = e1.dot(&g1) - rest_volume;
     let dl = (-c_value - alpha_tilde * lambda) / denom;
-    let mut out = TetCorrections4 {
-        moves: [false; LANES],
-        dl: dl.to_array(),
-        dp: [[Vec3::zeros(); LANES]; 4],
-    };
-    g0.scale(wa * dl).store(&mut out.dp[0]);
-    g1.scale(wb * dl).store(&mut out.dp[1]);
-    g2.scale(wc * dl).store(&mut out.dp[2]);
-    g3.scale(wd * dl).store(&mut out.dp[3]);
-    let denom = denom.to_array();
-    for (moves, denom) in out.moves.iter_mut().zip(denom) {
+    TetCorrections4 {
         // A NaN denominator moves, as in the scalar formula (and the step reports the
         // divergence).
-        *moves = denom > Real::MIN_POSITIVE || denom.is_nan();
+        stays: denom.le(F4::splat(Real::MIN_POSITIVE)),
+        dl,
+        dp: [
+            g0.scale(wa * dl),
+            g1.scale(wb * dl),
+            g2.scale(wc * dl),
+            g3.scale(wd * dl),
+        ],
     }
-    out
 }
 
 /// The result of [`volume_tet_corrections4`], by lane.
 pub(crate) struct TetCorrections4 {
-    /// Whether the lane's tetrahedron moves: false where no particle can move (the scalar
+    /// The lanes whose tetrahedron does not move: no particle can move (the scalar
     /// projection's `None`).
-    pub(crate) moves: [bool; LANES],
+    pub(crate) stays: Mask4,
     /// The change of each lane's multiplier `Δλ`.
-    pub(crate) dl: [Real; LANES],
-    /// `dp[c][l]`: the correction (m) of corner `c` of lane `l`'s tetrahedron.
-    pub(crate) dp: [[Vec3; LANES]; 4],
+    pub(crate) dl: F4,
+    /// `dp[c]`: the correction (m) of corner `c` of each lane's tetrahedron.
+    pub(crate) dp: [V4; 4],
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::LANES;
     use crate::math::tet_volume;
 
     /// Every lane of the four-lane projection gives the scalar projection's bits, whatever the
@@ -140,7 +137,12 @@ mod tests {
                     lanes(&|l| at(l).3),
                     lanes(&|l| at(l).4),
                 );
-                let got = got.moves[lane].then(|| (got.dl[lane], got.dp.map(|d| d[lane])));
+                let dp = got.dp.map(|d| {
+                    let mut lanes = [Vec3::zeros(); LANES];
+                    d.store(&mut lanes);
+                    lanes[lane]
+                });
+                let got = (!got.stays.lane(lane)).then(|| (got.dl.to_array()[lane], dp));
                 match (got, expected) {
                     (Some((dl, dp)), Some(expected_dp)) => {
                         assert_eq!(lambda + dl, updated, "case {case}, lane {lane}");

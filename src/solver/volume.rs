@@ -70,20 +70,27 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             let corner = |c: usize| V4::from_refs(each_lane(|l| &*x[l][c]));
             let mass = |c: usize| F4::new(each_lane(|l| body.inv_mass[k[l][c] as usize]));
             let v0 = F4::new(each_lane(|l| colouring.rest_volume[t[l]]));
+            let corners = each_lane(corner);
             let corrections = volume_tet_corrections4(
-                each_lane(corner),
+                corners,
                 each_lane(mass),
                 v0,
                 F4::splat(compliance_per_h2) * v0,
                 F4::new(each_lane(|l| *multiplier[l])),
             );
-            for (l, (x, multiplier)) in x.into_iter().zip(multiplier).enumerate() {
-                if corrections.moves[l] {
-                    *multiplier += corrections.dl[l];
-                    for (c, x) in x.into_iter().enumerate() {
-                        *x += corrections.dp[c][l];
-                    }
+            let dl = corrections.dl.to_array();
+            for l in 0..LANES {
+                if !corrections.stays.lane(l) {
+                    *multiplier[l] += dl[l];
                 }
+            }
+            // Each corner moved lane-wise (the scalar `x += dp`), written back through the
+            // references.
+            let [x0, x1, x2, x3] = x;
+            for c in 0..4 {
+                let moved = corners[c] + corrections.dp[c];
+                let kept = V4::select(corrections.stays, &corners[c], &moved);
+                kept.store_refs([&mut *x0[c], &mut *x1[c], &mut *x2[c], &mut *x3[c]]);
             }
         }
         let steps = blocks.iter().map(|b| b.len()).max().unwrap_or(0);
