@@ -586,17 +586,21 @@ fn barycentric(q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> [Real; 3] {
 mod tests {
     use super::*;
 
-    /// The path box's quick test keeps every triangle the exact test keeps, and still turns
-    /// away most of those far from the path: random slivers and segments, near and far.
-    #[test]
-    fn the_path_box_rejects_only_triangles_out_of_reach() {
-        let mut seed = 7_u64;
-        let mut random = move || {
+    /// Numbers uniform in [-0.5, 0.5) from a linear congruential generator started at `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> Real {
+        move || {
             seed = seed
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
-        };
+        }
+    }
+
+    /// The path box's quick test keeps every triangle the exact test keeps, and still turns
+    /// away most of those far from the path: random slivers and segments, near and far.
+    #[test]
+    fn the_path_box_rejects_only_triangles_out_of_reach() {
+        let mut random = uniform(7);
         let mut point = |scale: Real| Vec3::new(random(), random(), random()) * scale;
         let (mut kept, mut rejected) = (0, 0);
         for case in 0..20_000 {
@@ -636,13 +640,7 @@ mod tests {
     /// axis, to GJK's accuracy on a curved shape, and never a larger gap than GJK's.
     #[test]
     fn the_sphere_closed_form_agrees_with_gjk_and_epa() {
-        let mut seed = 11_u64;
-        let mut random = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
-        };
+        let mut random = uniform(11);
         let (radius, skin) = (0.1, 0.02);
         let ball = Ball::new(radius);
         let mut epa = EPA::new();
