@@ -248,12 +248,7 @@ impl V4 {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
         avx::transpose_out([self.x.0, self.y.0, self.z.0], out);
         #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-        {
-            let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-            for (l, o) in out.iter_mut().enumerate() {
-                *o = Vec3::new(x[l], y[l], z[l]);
-            }
-        }
+        self.store_refs(out.each_mut());
     }
     /// Write vector `l` to `*out[l]`: a transpose and two stores a vector with AVX, otherwise
     /// one component at a time.
