@@ -249,6 +249,31 @@ impl ParticleState {
         self.v.clone_from(&other.v);
         self.rotation.clone_from(&other.rotation);
     }
+
+    /// [`ParticleState::assign`], each thread of `pool` copying a range of particles when the
+    /// particle counts are the same (the copy of a large body is bound by one core's memory
+    /// bandwidth).
+    pub(crate) fn assign_on(&mut self, other: &ParticleState, pool: &Pool) {
+        let n = other.x.len();
+        if pool.threads() == 1 || self.x.len() != n {
+            return self.assign(other);
+        }
+        let x = SharedSlice::new(&mut self.x);
+        let v = SharedSlice::new(&mut self.v);
+        let rotation = SharedSlice::new(&mut self.rotation);
+        pool.for_each_range(n, &|range| {
+            // SAFETY: the ranges of the shares are disjoint.
+            unsafe {
+                x.range(range.clone())
+                    .copy_from_slice(&other.x[range.clone()]);
+                v.range(range.clone())
+                    .copy_from_slice(&other.v[range.clone()]);
+                rotation
+                    .range(range.clone())
+                    .copy_from_slice(&other.rotation[range]);
+            }
+        });
+    }
 }
 
 /// A deformable body (see the module documentation).

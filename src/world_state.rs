@@ -113,7 +113,7 @@ impl World {
         for (k, body) in self.bodies.iter().enumerate() {
             match out.bodies.get_mut(k) {
                 Some(s) => {
-                    s.particles.assign(&body.state);
+                    s.particles.assign_on(&body.state, &self.pool);
                     s.fixed.clone_from(&body.fixed);
                     s.cuts = crate::cut::cut_sets(body);
                 }

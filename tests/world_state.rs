@@ -18,7 +18,16 @@ const RADIUS: Real = 0.001;
 /// after a slow insertion (punctured, particles held on the shaft), and a grasping sphere at a
 /// corner of the top face.
 fn scene(depth: Real) -> (World, BodyId, ToolId) {
-    let mut w = World::new(Settings::default()).unwrap();
+    scene_on(depth, 1)
+}
+
+/// [`scene`] on `threads` threads.
+fn scene_on(depth: Real, threads: u32) -> (World, BodyId, ToolId) {
+    let settings = Settings {
+        threads,
+        ..Settings::default()
+    };
+    let mut w = World::new(settings).unwrap();
     let lo = Vec3::new(-SIDE / 2.0, 0.0, -SIDE / 2.0);
     let hi = Vec3::new(SIDE / 2.0, SIDE, SIDE / 2.0);
     let b = w
@@ -120,21 +129,24 @@ fn a_diverged_step_leaves_the_whole_state_as_it_was() {
     calm.step().unwrap();
     assert_ne!(calm.needle_state(needle).unwrap().held, held);
 
-    let (mut w, b, needle) = scene(0.01);
-    let body = w.body(b).unwrap();
-    let (x, mut v) = (body.positions().to_vec(), body.velocities().to_vec());
-    let free = (0..x.len()).find(|&i| !body.is_fixed(i)).unwrap();
-    // 500 body sizes per second: accepted as a state, beyond the step's limit of 250.
-    v[free] = Vec3::new(500.0 * SIDE * 3f64.sqrt(), 0.0, 0.0);
-    w.set_body_state(b, &x, &v).unwrap();
-    w.set_tool_pose(needle, deeper).unwrap();
-    let before = w.state();
-    match w.step() {
-        Err(Error::Diverged(m)) => assert!(m.contains("moves at"), "{m}"),
-        other => panic!("the step did not diverge: {other:?}"),
+    // On two threads too: each step's copy of the state is then split over the threads.
+    for threads in [1, 2] {
+        let (mut w, b, needle) = scene_on(0.01, threads);
+        let body = w.body(b).unwrap();
+        let (x, mut v) = (body.positions().to_vec(), body.velocities().to_vec());
+        let free = (0..x.len()).find(|&i| !body.is_fixed(i)).unwrap();
+        // 500 body sizes per second: accepted as a state, beyond the step's limit of 250.
+        v[free] = Vec3::new(500.0 * SIDE * 3f64.sqrt(), 0.0, 0.0);
+        w.set_body_state(b, &x, &v).unwrap();
+        w.set_tool_pose(needle, deeper).unwrap();
+        let before = w.state();
+        match w.step() {
+            Err(Error::Diverged(m)) => assert!(m.contains("moves at"), "{m}"),
+            other => panic!("the step did not diverge on {threads} threads: {other:?}"),
+        }
+        assert_eq!(w.state(), before, "{threads} threads");
+        assert_eq!(w.diverged_steps(), 1);
     }
-    assert_eq!(w.state(), before);
-    assert_eq!(w.diverged_steps(), 1);
 }
 
 #[test]
