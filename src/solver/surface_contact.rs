@@ -8,16 +8,17 @@
 //! penetration depth when they overlap). A sphere's are exact and in closed form, from the
 //! triangle's point closest to the centre: GJK and EPA, iterative on a curved shape, were 60%
 //! of this pass's narrow phase in the haptic scene, and stop up to 1e-4 radii short of the
-//! exact separation. A triangle-mesh tool is taken as its vertices' convex hull for GJK. When `d < r` the triangle is pushed away from the tool by `r − d` (at most
-//! `max_correction` per projection beyond the contact point's predicted motion towards the tool in the substep), the
-//! correction spread over its three particles by barycentric weights so that the contact point
-//! moves by exactly that much (the point–triangle constraint of PBD), with Coulomb friction on
-//! the contact point's motion relative to the tool. The triangles of a dent share particles and
-//! undo part of each other's corrections, so the pass repeats over the triangles near the tool
-//! until the largest correction is below a hundredth of the skin (at most
-//! [`MAX_SURFACE_PASSES`]): with a single pass a 1 mm sphere pressed 2 cm into the default organ
-//! slipped through the steep walls of the funnel it made (two passes: 20 steps inside out of 640;
-//! three or more: none).
+//! exact separation. A triangle-mesh tool is taken as its vertices' convex hull for GJK.
+//! When `d < r` the triangle is pushed away from the tool by `r − d` (at most `max_correction`
+//! per projection beyond the contact point's predicted motion towards the tool in the
+//! substep), the correction spread over its three particles by barycentric weights so that
+//! the contact point moves by exactly that much (the point–triangle constraint of PBD), with
+//! Coulomb friction on the contact point's motion relative to the tool. The triangles of a
+//! dent share particles and undo part of each other's corrections, so the pass repeats over
+//! the triangles near the tool until the largest correction is below a hundredth of the skin
+//! (at most [`MAX_SURFACE_PASSES`]): with a single pass a 1 mm sphere pressed 2 cm into the
+//! default organ slipped through the steep walls of the funnel it made (two passes: 20 steps
+//! inside out of 640; three or more: none).
 //!
 //! The contact is one-sided, so that no depth or speed lets the tool through:
 //! - a tool that came from in front of the triangle (the middle of its extent along `n` was in
