@@ -202,11 +202,8 @@ impl BodyModel {
             + size_of_val(n.incoming_offsets.as_slice())
             + size_of_val(n.incoming.as_slice())
             + size_of_val(n.sources.as_slice())
-            + size_of_val(self.tet_colouring.tets.as_slice())
-            + size_of_val(self.tet_colouring.rest_volume.as_slice())
-            + size_of_val(self.tet_colouring.blocks.as_slice())
+            + self.tet_colouring.heap_bytes()
             + 2 * size_of_val(self.order.mesh_indices())
-            + size_of_val(self.tet_colouring.starts.as_slice())
     }
 }
 

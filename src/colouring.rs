@@ -22,23 +22,34 @@ use crate::math::Real;
 pub(crate) const BLOCK: usize = 128;
 
 /// The blocks of tetrahedra grouped by colour.
+///
+/// Invariant (checked by [`TetColouring::new`], kept by the private fields): every particle
+/// index of `tets` is below `particles`, so the volume pass reads its corners without a check
+/// per index.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct TetColouring {
     /// The body's tetrahedra (four particle indices each) in projection order.
-    pub(crate) tets: Vec<[u32; 4]>,
+    tets: Vec<[u32; 4]>,
     /// Their rest volumes (m³), in the same order.
-    pub(crate) rest_volume: Vec<Real>,
+    rest_volume: Vec<Real>,
     /// The blocks, colour by colour, increasing within a colour: the position in `tets` of
     /// each block's first tetrahedron (a block holds `BLOCK` tetrahedra, fewer for the last).
-    pub(crate) blocks: Vec<u32>,
+    blocks: Vec<u32>,
     /// Where each colour starts in `blocks`, then `blocks.len()`.
-    pub(crate) starts: Vec<u32>,
+    starts: Vec<u32>,
+    /// The number of particles of the body: every index of `tets` is below it.
+    particles: usize,
 }
 
 impl TetColouring {
-    /// Order and colour `tets` (4 particle indices each, all below `particles`) with their rest
-    /// volumes `rest_volume` (m³).
+    /// Order and colour `tets` (4 particle indices each, all below `particles`: panics
+    /// otherwise) with their rest volumes `rest_volume` (m³).
     pub(crate) fn new(tets: &[[u32; 4]], rest_volume: &[Real], particles: usize) -> TetColouring {
+        assert!(
+            tets.iter().flatten().all(|&k| (k as usize) < particles),
+            "a tetrahedron's particle index is out of range"
+        );
+        assert_eq!(tets.len(), rest_volume.len());
         let mut order: Vec<u32> = (0..tets.len() as u32).collect();
         order.sort_by_key(|&t| (tets[t as usize].iter().min().copied(), t));
         // Per colour, whether each particle is taken by one of its blocks.
@@ -78,7 +89,32 @@ impl TetColouring {
             rest_volume: order.iter().map(|&t| rest_volume[t as usize]).collect(),
             blocks,
             starts,
+            particles,
         }
+    }
+
+    /// The tetrahedra (four particle indices each, every one below
+    /// [`particle_count`](Self::particle_count)) in projection order.
+    pub(crate) fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// The rest volumes (m³) of [`tets`](Self::tets), in the same order.
+    pub(crate) fn rest_volume(&self) -> &[Real] {
+        &self.rest_volume
+    }
+
+    /// The number of particles of the body the tetrahedra index.
+    pub(crate) fn particle_count(&self) -> usize {
+        self.particles
+    }
+
+    /// The heap memory held (bytes).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        size_of_val(self.tets.as_slice())
+            + size_of_val(self.rest_volume.as_slice())
+            + size_of_val(self.blocks.as_slice())
+            + size_of_val(self.starts.as_slice())
     }
 
     /// The blocks of each colour (first tetrahedron of each), in colour order.
@@ -140,6 +176,16 @@ mod tests {
         }
         assert!(seen.iter().all(|&n| n == 1));
         c
+    }
+
+    /// The volume pass reads corners without a check per index: a tetrahedron naming a
+    /// particle past the count is refused when the colouring is built.
+    #[test]
+    #[should_panic(expected = "out of range")]
+    fn an_index_past_the_particle_count_is_refused() {
+        let mesh = lattice_box(Vec3::zeros(), Vec3::repeat(1.0), [2, 2, 2]);
+        let rest_volume = volumes(&mesh);
+        TetColouring::new(&mesh.tets, &rest_volume, mesh.nodes.len() - 1);
     }
 
     #[test]

@@ -219,6 +219,23 @@ impl<T> SharedSlice<T> {
         // SAFETY: in bounds (checked) and exclusive by the caller's contract.
         unsafe { &mut *self.ptr.add(i) }
     }
+    /// Element `i`, mutable, its index not checked (for loops whose indices are validated
+    /// once, outside the loop).
+    ///
+    /// # Safety
+    /// `i` is below the slice's length, and no other share may access element `i` during the
+    /// job.
+    #[allow(clippy::mut_from_ref)]
+    #[inline(always)]
+    pub unsafe fn element_unchecked(&self, i: usize) -> &mut T {
+        debug_assert!(i < self.len);
+        // SAFETY: in bounds and exclusive by the caller's contract.
+        unsafe { &mut *self.ptr.add(i) }
+    }
+    /// The slice's length.
+    pub fn len(&self) -> usize {
+        self.len
+    }
 }
 
 /// A barrier for the shares of one `Pool::run` job that run in phases (a phase's writes are

@@ -35,8 +35,8 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
     // tetrahedron's multiplier is its own; a share projects only its blocks of the colour, and
     // the shares meet at the barrier before the next colour.
     let project_tet = |t: usize| {
-        let k = colouring.tets[t].map(|k| k as usize);
-        let v0 = colouring.rest_volume[t];
+        let k = colouring.tets()[t].map(|k| k as usize);
+        let v0 = colouring.rest_volume()[t];
         let x = k.map(|k| *unsafe { p.element(k) });
         let w = k.map(|k| body.inv_mass[k]);
         let lambda = unsafe { lambda.element(t) };
@@ -47,6 +47,10 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             }
         }
     };
+    // The lanes read their corners without a check per index: every index of the colouring
+    // is below its particle count (its invariant), which is that of both arrays.
+    let particles = colouring.particle_count();
+    assert!(p.len() == particles && body.inv_mass.len() == particles);
     // Four blocks of one colour in lock-step, the s-th tetrahedron of each a lane, while all
     // four have one; the rest interleaved tetrahedron by tetrahedron, so that consecutive
     // projections touch different particles and overlap in the processor. The blocks share no
@@ -60,28 +64,39 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
             LANES => blocks.iter().map(|b| b.len()).min().unwrap_or(0),
             _ => 0,
         };
+        // Per lane, the first `together` tetrahedra of its block, their rest volumes and their
+        // multipliers.
+        let lane_tets = each_lane(|l| &colouring.tets()[blocks[l].start..][..together]);
+        let lane_v0 = each_lane(|l| &colouring.rest_volume()[blocks[l].start..][..together]);
+        // SAFETY: the four blocks are disjoint ranges of tetrahedra, each projected by this
+        // share alone.
+        let lane_lambda =
+            each_lane(|l| unsafe { lambda.range(blocks[l].start..blocks[l].start + together) });
         for s in 0..together {
-            let t = each_lane(|l| blocks[l].start + s);
-            let k = each_lane(|l| colouring.tets[t[l]]);
+            let k = each_lane(|l| lane_tets[l][s].map(|k| k as usize));
             // SAFETY: sixteen distinct particles (four of a tetrahedron, and the blocks share
-            // none) and four distinct multipliers, each held once.
-            let x = each_lane(|l| each_lane(|c| unsafe { p.element(k[l][c] as usize) }));
-            let multiplier = each_lane(|l| unsafe { lambda.element(t[l]) });
+            // none), each held once; every index is below the particle count (checked above).
+            let x = each_lane(|l| each_lane(|c| unsafe { p.element_unchecked(k[l][c]) }));
             let corner = |c: usize| V4::from_refs(each_lane(|l| &*x[l][c]));
-            let mass = |c: usize| F4::new(each_lane(|l| body.inv_mass[k[l][c] as usize]));
-            let v0 = F4::new(each_lane(|l| colouring.rest_volume[t[l]]));
+            // SAFETY: as for `x`.
+            let mass = |c: usize| {
+                F4::new(each_lane(|l| unsafe {
+                    *body.inv_mass.get_unchecked(k[l][c])
+                }))
+            };
+            let v0 = F4::new(each_lane(|l| lane_v0[l][s]));
             let corners = each_lane(corner);
             let corrections = volume_tet_corrections4(
                 corners,
                 each_lane(mass),
                 v0,
                 F4::splat(compliance_per_h2) * v0,
-                F4::new(each_lane(|l| *multiplier[l])),
+                F4::new(each_lane(|l| lane_lambda[l][s])),
             );
             let dl = corrections.dl.to_array();
             for l in 0..LANES {
                 if !corrections.stays.lane(l) {
-                    *multiplier[l] += dl[l];
+                    lane_lambda[l][s] += dl[l];
                 }
             }
             // Each corner moved lane-wise (the scalar `x += dp`), written back through the
