@@ -16,9 +16,27 @@ pub(crate) fn predict(
     damping_factor: Real,
     pool: &Pool,
 ) {
-    for i in 0..body.state.x.len() {
-        scratch.force[i] = gravity * body.model.mass[i];
-    }
+    // Gravity into the forces, and the volume constraints' multipliers of the substep reset,
+    // each share its range.
+    let mass = &body.model.mass;
+    let (forces, multipliers) = (
+        SharedSlice::new(&mut scratch.force),
+        SharedSlice::new(&mut scratch.tet_lambda),
+    );
+    pool.run(&|share| {
+        let particles = pool.share(share, mass.len());
+        // SAFETY: the shares' ranges are disjoint.
+        let (f, lambda) = unsafe {
+            (
+                forces.range(particles.clone()),
+                multipliers.range(pool.share(share, multipliers.len())),
+            )
+        };
+        for (f, &m) in f.iter_mut().zip(&mass[particles]) {
+            *f = gravity * m;
+        }
+        lambda.fill(0.0);
+    });
     let input = ForceInputs {
         nbr: &body.model.nbr,
         volume: &body.model.particle_volume,
@@ -60,5 +78,4 @@ pub(crate) fn predict(
             }
         }
     });
-    scratch.tet_lambda.iter_mut().for_each(|l| *l = 0.0);
 }
