@@ -408,6 +408,17 @@ impl<'a> PairChunks<'a> {
         assert!(out.u.iter().chain(&out.d).all(|c| c.len() == n) && out.w.len() == n);
         out
     }
+    /// The chunks `chunks` of these.
+    #[inline(always)]
+    fn sub(&self, chunks: Range<usize>) -> PairChunks<'a> {
+        let c = chunks;
+        PairChunks {
+            j: &self.j[c.clone()],
+            u: self.u.map(|a| &a[c.clone()]),
+            d: self.d.map(|a| &a[c.clone()]),
+            w: &self.w[c],
+        }
+    }
     #[inline(always)]
     fn len(&self) -> usize {
         self.j.len()
@@ -454,10 +465,13 @@ fn block_pair_forces(
         let s = nbr.slots(i);
         (s.start - base) / LANES..(s.end - base) / LANES
     };
+    // The rest data of the block's slots, split once into chunks.
+    let rest = PairChunks::new(nbr, base..nbr.offsets[particles.end] as usize);
     let mut f = [Mat3::identity(); LANES];
     let mut volume = [0.0; LANES];
     for (l, i) in particles.clone().enumerate() {
-        f[l] = gradient_pass(input, i, &mut buffer.offset[chunks(i)]);
+        let rest = rest.sub(chunks(i));
+        f[l] = gradient_pass(input, i, &rest, &mut buffer.offset[chunks(i)]);
         volume[l] = input.volume[i];
     }
     let f4 = M4::from_matrices(&f);
@@ -468,6 +482,7 @@ fn block_pair_forces(
         own[l] = pair_pass(
             pass,
             i,
+            &rest.sub(chunks(i)),
             (&f[l], &stress.lane(l)),
             &buffer.offset[chunks(i)],
             &mut buffer.residual,
@@ -476,12 +491,16 @@ fn block_pair_forces(
     }
 }
 
-/// Pass 1 of particle `i`: `F = I + Σ (x_ij - u_ij) d_ijᵀ` (dimensionless), keeping the
-/// offsets `x_ij` (m) of its slots in `offset` (one entry per chunk of four).
+/// Pass 1 of particle `i`, `rest` the rest data of its slots: `F = I + Σ (x_ij - u_ij) d_ijᵀ`
+/// (dimensionless), keeping the offsets `x_ij` (m) of its slots in `offset` (one entry per
+/// chunk of four).
 #[inline(always)]
-fn gradient_pass(input: &ForceInputs<'_>, i: usize, offset: &mut [V4]) -> Mat3 {
-    let nbr = input.nbr;
-    let rest = PairChunks::new(nbr, nbr.slots(i));
+fn gradient_pass(
+    input: &ForceInputs<'_>,
+    i: usize,
+    rest: &PairChunks<'_>,
+    offset: &mut [V4],
+) -> Mat3 {
     let offset = &mut offset[..rest.len()];
     let xi = V4::splat(&input.x[i]);
     let mut fsum = M4::default();
@@ -493,21 +512,21 @@ fn gradient_pass(input: &ForceInputs<'_>, i: usize, offset: &mut [V4]) -> Mat3 {
     fsum.sum() + Mat3::identity()
 }
 
-/// Passes 2 and 3 of particle `i`, given its deformation gradient and its stress times its
-/// volume `v_i P_i` (N·m) in `(f, stress)` and its offsets `x_ij` from pass 1: the force `g_ij`
-/// (N) of each pair slot written to `pair_force`, their sum returned.
+/// Passes 2 and 3 of particle `i` (`rest`: the rest data of its slots), given its deformation
+/// gradient and its stress times its volume `v_i P_i` (N·m) in `(f, stress)` and its offsets
+/// `x_ij` from pass 1: the force `g_ij` (N) of each pair slot written to `pair_force`, their
+/// sum returned.
 #[inline(always)]
 fn pair_pass(
     pass: &ParticlePass<'_, '_>,
     i: usize,
+    rest: &PairChunks<'_>,
     (f, stress): (&Mat3, &Mat3),
     offset: &[V4],
     residual: &mut [V4],
     pair_force: &mut [[Vec3; LANES]],
 ) -> Vec3 {
     let (model, input) = (pass.model, pass.input);
-    let nbr = input.nbr;
-    let rest = PairChunks::new(nbr, nbr.slots(i));
     let chunks = rest.len();
     let (offset, residual) = (&offset[..chunks], &mut residual[..chunks]);
     let pair_force = &mut pair_force[..chunks];
