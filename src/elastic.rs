@@ -411,12 +411,11 @@ impl<'a> PairChunks<'a> {
     /// The chunks `chunks` of these.
     #[inline(always)]
     fn sub(&self, chunks: Range<usize>) -> PairChunks<'a> {
-        let c = chunks;
         PairChunks {
-            j: &self.j[c.clone()],
-            u: self.u.map(|a| &a[c.clone()]),
-            d: self.d.map(|a| &a[c.clone()]),
-            w: &self.w[c],
+            j: &self.j[chunks.clone()],
+            u: self.u.map(|a| &a[chunks.clone()]),
+            d: self.d.map(|a| &a[chunks.clone()]),
+            w: &self.w[chunks],
         }
     }
     #[inline(always)]
@@ -470,8 +469,8 @@ fn block_pair_forces(
     let mut f = [Mat3::identity(); LANES];
     let mut volume = [0.0; LANES];
     for (l, i) in particles.clone().enumerate() {
-        let rest = rest.sub(chunks(i));
-        f[l] = gradient_pass(input, i, &rest, &mut buffer.offset[chunks(i)]);
+        let c = chunks(i);
+        f[l] = gradient_pass(input, i, &rest.sub(c.clone()), &mut buffer.offset[c]);
         volume[l] = input.volume[i];
     }
     let f4 = M4::from_matrices(&f);
@@ -479,14 +478,15 @@ fn block_pair_forces(
     let stress = corotated_stress(&f4, &r4, model.lambda, model.mu).scale(F4::new(volume));
     let pair_force = pair_force.as_chunks_mut::<LANES>().0;
     for (l, i) in particles.enumerate() {
+        let c = chunks(i);
         own[l] = pair_pass(
             pass,
             i,
-            &rest.sub(chunks(i)),
+            &rest.sub(c.clone()),
             (&f[l], &stress.lane(l)),
-            &buffer.offset[chunks(i)],
+            &buffer.offset[c.clone()],
             &mut buffer.residual,
-            &mut pair_force[chunks(i)],
+            &mut pair_force[c],
         );
     }
 }
