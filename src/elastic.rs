@@ -262,7 +262,8 @@ fn keep_pass(
 /// chunk's operands live at once: more than AVX2's 16 vector registers, so some spill to the
 /// stack every chunk. Processors with AVX-512 (VL) have 32 registers for the same 256-bit
 /// instructions; on them the loops run in a copy compiled with those features. The arithmetic
-/// is the same lane-wise IEEE operations (no fused multiply–add), so both give the same bits.
+/// is the same lane-wise IEEE operations (fused multiply–adds where the build has FMA, in both
+/// copies: `wide` decides at the build's target, not the copy's), so both give the same bits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kernel {
     /// Compiled for the build's target (x86-64-v3 in this repository, `.cargo/config.toml`).
@@ -539,7 +540,7 @@ fn pair_pass(
         let fl = M4::splat(f);
         for (k, (o, eps)) in offset.iter().zip(residual.iter_mut()).enumerate() {
             let c = rest.get(k);
-            *eps = fl.mul(&c.u) - *o;
+            *eps = fl.mul_sub(&c.u, o);
             qsum.add_outer(eps, &c.u.scale(c.w * c_scale));
         }
     } else {
@@ -552,7 +553,7 @@ fn pair_pass(
     let mut fi = V4::default();
     for (k, (o, eps)) in offset.iter().zip(residual.iter()).enumerate() {
         let c = rest.get(k);
-        let mut g = m.mul(&c.d) - eps.scale(c.w * c_scale);
+        let mut g = eps.scale_sub_from(c.w * c_scale, &m.mul(&c.d));
         if damping > 0.0 {
             // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
             let len2 = o.dot(o);
@@ -562,7 +563,7 @@ fn pair_pass(
             // infinity or a NaN) is computed but not selected.
             let s = (F4::splat(damping) * k2 * rate) / len2;
             let separated = F4::splat(1.0e-30).lt(len2);
-            g += o.scale(separated.select(s, F4::splat(0.0)));
+            g = o.scale_add(separated.select(s, F4::splat(0.0)), &g);
         }
         g.store(&mut pair_force[k]);
         fi += g;

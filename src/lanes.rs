@@ -2,8 +2,13 @@
 //! build for x86-64-v3 (this repository's default, `.cargo/config.toml`), two SSE2 registers on
 //! baseline x86-64, two NEON registers on aarch64, plain arrays elsewhere.
 //!
-//! Every operation is lane-wise IEEE arithmetic: no fused multiply–add and no reassociation, so
-//! every build gives the same bits. Only [`F4::sum`] crosses lanes, in a fixed order.
+//! Every operation is lane-wise IEEE arithmetic in a fixed order, without reassociation: a lane
+//! gives the bits it would give alone, on any number of threads. Products that are added (dot
+//! and cross products, matrix–vector products, outer-product sums and the explicit
+//! `mul_add`-style methods) use a fused multiply–add, rounded once, where the build targets
+//! FMA on x86-64 (x86-64-v3, this repository's default); elsewhere (baseline x86-64, aarch64)
+//! `wide` rounds the product, then the sum. So a build with FMA and one without differ in the
+//! last bits; each is deterministic. Only [`F4::sum`] crosses lanes, in a fixed order.
 
 use crate::math::{Mat3, Real, Vec3};
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -51,6 +56,21 @@ impl F4 {
     #[inline(always)]
     pub(crate) fn le(self, o: F4) -> Mask4 {
         Mask4(self.0.cmp_le(o.0))
+    }
+    /// Lane-wise `self * m + a`, rounded once where the build has FMA (see the module doc).
+    #[inline(always)]
+    pub(crate) fn mul_add(self, m: F4, a: F4) -> F4 {
+        F4(self.0.mul_add(m.0, a.0))
+    }
+    /// Lane-wise `self * m - a`, rounded once where the build has FMA.
+    #[inline(always)]
+    pub(crate) fn mul_sub(self, m: F4, a: F4) -> F4 {
+        F4(self.0.mul_sub(m.0, a.0))
+    }
+    /// Lane-wise `a - self * m`, rounded once where the build has FMA.
+    #[inline(always)]
+    pub(crate) fn mul_neg_add(self, m: F4, a: F4) -> F4 {
+        F4(self.0.mul_neg_add(m.0, a.0))
     }
     /// `(l0 + l1) + (l2 + l3)`.
     #[inline(always)]
@@ -213,15 +233,15 @@ impl V4 {
     #[inline(always)]
     pub(crate) fn cross(&self, o: &V4) -> V4 {
         V4 {
-            x: self.y * o.z - self.z * o.y,
-            y: self.z * o.x - self.x * o.z,
-            z: self.x * o.y - self.y * o.x,
+            x: self.y.mul_sub(o.z, self.z * o.y),
+            y: self.z.mul_sub(o.x, self.x * o.z),
+            z: self.x.mul_sub(o.y, self.y * o.x),
         }
     }
     /// Lane-wise dot product.
     #[inline(always)]
     pub(crate) fn dot(&self, o: &V4) -> F4 {
-        self.x * o.x + self.y * o.y + self.z * o.z
+        self.z.mul_add(o.z, self.y.mul_add(o.y, self.x * o.x))
     }
     /// Every lane scaled by the lane's `s`.
     #[inline(always)]
@@ -230,6 +250,24 @@ impl V4 {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
+        }
+    }
+    /// Lane-wise `a + self * s`, rounded once per component where the build has FMA.
+    #[inline(always)]
+    pub(crate) fn scale_add(&self, s: F4, a: &V4) -> V4 {
+        V4 {
+            x: self.x.mul_add(s, a.x),
+            y: self.y.mul_add(s, a.y),
+            z: self.z.mul_add(s, a.z),
+        }
+    }
+    /// Lane-wise `a - self * s`, rounded once per component where the build has FMA.
+    #[inline(always)]
+    pub(crate) fn scale_sub_from(&self, s: F4, a: &V4) -> V4 {
+        V4 {
+            x: self.x.mul_neg_add(s, a.x),
+            y: self.y.mul_neg_add(s, a.y),
+            z: self.z.mul_neg_add(s, a.z),
         }
     }
     /// Lane-wise `if mask { t } else { f }`.
@@ -481,10 +519,9 @@ impl M4 {
     /// Lane-wise `self += a bᵀ`.
     #[inline(always)]
     pub(crate) fn add_outer(&mut self, a: &V4, b: &V4) {
-        let [r0, r1, r2] = &mut self.rows;
-        *r0 += b.scale(a.x);
-        *r1 += b.scale(a.y);
-        *r2 += b.scale(a.z);
+        for (r, s) in self.rows.iter_mut().zip([a.x, a.y, a.z]) {
+            *r = b.scale_add(s, r);
+        }
     }
     /// Lane-wise `self v`.
     #[inline(always)]
@@ -494,6 +531,18 @@ impl M4 {
             x: r0.dot(v),
             y: r1.dot(v),
             z: r2.dot(v),
+        }
+    }
+    /// Lane-wise `self v - a`: each component `x - a` first, then the other two products
+    /// added, each rounded once where the build has FMA.
+    #[inline(always)]
+    pub(crate) fn mul_sub(&self, v: &V4, a: &V4) -> V4 {
+        let row = |r: &V4, a: F4| r.z.mul_add(v.z, r.y.mul_add(v.y, r.x.mul_sub(v.x, a)));
+        let [r0, r1, r2] = &self.rows;
+        V4 {
+            x: row(r0, a.x),
+            y: row(r1, a.y),
+            z: row(r2, a.z),
         }
     }
     /// The sum of the four matrices.
@@ -523,6 +572,31 @@ mod tests {
         // Pairwise, each 1 is rounded away against 1e16: 0. Left to right would give 1.
         assert_eq!(a.sum(), 0.0);
         assert_eq!(a * F4::splat(2.0) - a + F4::default(), a);
+    }
+
+    /// Where the build targets FMA, the products that are added are rounded once: `(1 + ε)(1 - ε)
+    /// - 1` is `-ε²` fused, 0 rounded twice. Elsewhere, twice (the module doc's contract).
+    #[test]
+    fn products_are_fused_exactly_where_the_build_has_fma() {
+        let e = Real::EPSILON;
+        let a = F4::splat(1.0 + e);
+        let b = F4::splat(1.0 - e);
+        let fused = cfg!(all(target_arch = "x86_64", target_feature = "fma"));
+        let expected = if fused { -e * e } else { 0.0 };
+        assert_eq!(a.mul_sub(b, F4::splat(1.0)).to_array(), [expected; LANES]);
+        // The dot product: the first product -1 (exact), then (1 + ε)(1 - ε) added to it.
+        let (zero, one) = (F4::splat(0.0), F4::splat(1.0));
+        let v = V4 {
+            x: one,
+            y: a,
+            z: zero,
+        };
+        let w = V4 {
+            x: -one,
+            y: b,
+            z: zero,
+        };
+        assert_eq!(v.dot(&w).to_array(), [expected; LANES]);
     }
 
     /// Gathering by index and storing (to an array or through references) move every

@@ -156,18 +156,45 @@ pub(crate) fn extract_rotations(f: &M4, q: &mut [Quat], newton_iterations: u32) 
         let b = half * (f0.dot(r1) + f1.dot(r0));
         let c = half * (f0.dot(r2) + f2.dot(r0));
         let e = half * (f1.dot(r2) + f2.dot(r1));
-        let (m00, m01, m02) = (d * z - e * e, c * e - b * z, b * e - c * d);
-        let (m11, m12, m22) = (a * z - c * c, b * c - a * e, a * d - b * b);
-        let det = a * m00 + b * m01 + c * m02;
+        let (m00, m01, m02) = (
+            d.mul_sub(z, e * e),
+            c.mul_sub(e, b * z),
+            b.mul_sub(e, c * d),
+        );
+        let (m11, m12, m22) = (
+            a.mul_sub(z, c * c),
+            b.mul_sub(c, a * e),
+            a.mul_sub(d, b * b),
+        );
+        let det = V4 { x: a, y: b, z: c }.dot(&V4 {
+            x: m00,
+            y: m01,
+            z: m02,
+        });
         let zero = F4::splat(0.0);
         let indefinite = pending & (a.le(zero) | m22.le(zero) | det.le(zero));
         failed = failed | indefinite;
         pending = pending & !indefinite;
-        let delta = V4 {
-            x: (m00 * g.x + m01 * g.y + m02 * g.z) / det,
-            y: (m01 * g.x + m11 * g.y + m12 * g.z) / det,
-            z: (m02 * g.x + m12 * g.y + m22 * g.z) / det,
+        let adjugate = M4 {
+            rows: [
+                V4 {
+                    x: m00,
+                    y: m01,
+                    z: m02,
+                },
+                V4 {
+                    x: m01,
+                    y: m11,
+                    z: m12,
+                },
+                V4 {
+                    x: m02,
+                    y: m12,
+                    z: m22,
+                },
+            ],
         };
+        let delta = adjugate.mul(&g).scale(F4::splat(1.0) / det);
         quat = Q4::select(pending, &quat.turned(&delta.scale(F4::splat(0.5))), &quat);
         short = pending
             & delta
