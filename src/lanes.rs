@@ -128,6 +128,32 @@ impl AddAssign for F4 {
     }
 }
 
+/// One lane of [`F4::mul_add`]: `a * b + c`, rounded once exactly where the lanes are.
+#[inline(always)]
+fn mul_add(a: Real, b: Real, c: Real) -> Real {
+    if cfg!(all(target_arch = "x86_64", target_feature = "fma")) {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+/// One lane of [`V4::dot`], the same bits.
+#[inline(always)]
+pub(crate) fn dot(a: &Vec3, b: &Vec3) -> Real {
+    mul_add(a.z, b.z, mul_add(a.y, b.y, a.x * b.x))
+}
+
+/// One lane of [`V4::cross`], the same bits.
+#[inline(always)]
+pub(crate) fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
+    Vec3::new(
+        mul_add(a.y, b.z, -(a.z * b.y)),
+        mul_add(a.z, b.x, -(a.x * b.z)),
+        mul_add(a.x, b.y, -(a.y * b.x)),
+    )
+}
+
 /// A true or false per lane, as the comparisons of [`F4`] give it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Mask4(f64x4);
@@ -229,7 +255,7 @@ impl V4 {
             z: F4::new(a.map(|v| v.z)),
         }
     }
-    /// Lane-wise cross product, each component computed as nalgebra computes it.
+    /// Lane-wise cross product (each component `a b - c d`, the first product fused).
     #[inline(always)]
     pub(crate) fn cross(&self, o: &V4) -> V4 {
         V4 {

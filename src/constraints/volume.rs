@@ -1,6 +1,6 @@
 //! XPBD tetrahedral volume constraint (eq. 13 of the paper): `C = V(p1..p4) - V0 = 0`.
 
-use crate::lanes::{Mask4, F4, LANES, V4};
+use crate::lanes::{cross, dot, Mask4, F4, V4};
 use crate::math::{Real, Vec3};
 
 /// The projection of one tetrahedron's volume constraint.
@@ -12,8 +12,7 @@ use crate::math::{Real, Vec3};
 ///   0 makes the constraint hard;
 /// * `lambda` — the constraint's accumulated multiplier within this substep, updated.
 ///
-/// Returns the four position corrections (m; `None` when no particle can move). Computed by
-/// the solver's four-lane projection, so a tetrahedron gets the same bits from both.
+/// Returns the four position corrections (m; `None` when no particle can move).
 #[inline]
 pub fn volume_tet_correction(
     [pa, pb, pc, pd]: [Vec3; 4],
@@ -22,29 +21,40 @@ pub fn volume_tet_correction(
     alpha_tilde: Real,
     lambda: &mut Real,
 ) -> Option<[Vec3; 4]> {
-    // The four-lane projection with the tetrahedron in every lane: the same bits as when the
-    // solver projects it in a lane beside others.
-    let p = [pa, pb, pc, pd].map(|c| V4::splat(&c));
-    let w = [wa, wb, wc, wd].map(F4::splat);
-    let [v0, alpha, l0] = [rest_volume, alpha_tilde, *lambda].map(F4::splat);
-    let corrections = volume_tet_corrections4(p, w, v0, alpha, l0);
-    if corrections.stays.lane(0) {
+    let (e1, e2, e3) = (pb - pa, pc - pa, pd - pa);
+    // ∂V/∂p_b etc.; V = e1 · (e2 × e3) / 6 = e1 · g1. One lane of the four-lane formula below,
+    // with its fused products (`lanes::cross`, `lanes::dot`).
+    let g1 = cross(&e2, &e3) * (1.0 / 6.0);
+    let g2 = cross(&e3, &e1) * (1.0 / 6.0);
+    let g3 = cross(&e1, &e2) * (1.0 / 6.0);
+    let g0 = -(g1 + g2 + g3);
+    let denom = wa * dot(&g0, &g0)
+        + wb * dot(&g1, &g1)
+        + wc * dot(&g2, &g2)
+        + wd * dot(&g3, &g3)
+        + alpha_tilde;
+    let c_value = dot(&e1, &g1) - rest_volume;
+    if denom <= Real::MIN_POSITIVE {
         return None;
     }
-    *lambda += corrections.dl.to_array()[0];
-    Some(corrections.dp.map(|d| {
-        let mut lanes = [Vec3::zeros(); LANES];
-        d.store(&mut lanes);
-        lanes[0]
-    }))
+    let dl = (-c_value - alpha_tilde * *lambda) / denom;
+    *lambda += dl;
+    let dp = [
+        g0 * (wa * dl),
+        g1 * (wb * dl),
+        g2 * (wc * dl),
+        g3 * (wd * dl),
+    ];
+    Some(dp)
 }
 
 /// [`volume_tet_correction`] for four tetrahedra at once, one a lane, with the same
 /// arguments by lane (`p`, `w`, `rest_volume`, `alpha_tilde`, `lambda`; `lambda` is not
 /// updated: the result holds its change).
 ///
-/// Lane-wise IEEE operations (see [`crate::lanes`]); each lane gives the bits it would give
-/// alone, which [`volume_tet_correction`] computes with the tetrahedron in every lane.
+/// Lane-wise IEEE operations in the order of the scalar formula, the same products fused (see
+/// [`crate::lanes`]), so each lane gives the bits of [`volume_tet_correction`] for its
+/// tetrahedron.
 #[inline(always)]
 pub(crate) fn volume_tet_corrections4(
     [pa, pb, pc, pd]: [V4; 4],
@@ -91,13 +101,14 @@ pub(crate) struct TetCorrections4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::LANES;
     use crate::math::tet_volume;
 
-    /// Every lane of the four-lane projection gives the bits it gives alone (the scalar
-    /// projection's), whatever the other lanes hold: soft and hard constraints, a partly and a
-    /// fully fixed tetrahedron, an inverted one, a non-zero multiplier.
+    /// Every lane of the four-lane projection gives the scalar projection's bits, whatever the
+    /// other lanes hold: soft and hard constraints, a partly and a fully fixed tetrahedron, an
+    /// inverted one, a non-zero multiplier.
     #[test]
-    fn each_lane_gives_the_bits_it_gives_alone() {
+    fn each_lane_gives_the_scalar_projection_bits() {
         let p = [
             Vec3::new(0.1, -0.2, 0.05),
             Vec3::new(1.3, 0.1, -0.2),
