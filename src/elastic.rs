@@ -371,10 +371,10 @@ impl BlockBuffer {
     }
 }
 
-/// The rest data of four consecutive pair slots: neighbours `j`, rest offsets `u_ij` (m), MLS
-/// gradients `d_ij` (1/m) and hourglass weights `ŵ_ij / |u_ij|²` (1/m²).
+/// The rest data of four consecutive pair slots (their neighbours are gathered through
+/// [`PairChunks::gather`]): rest offsets `u_ij` (m), MLS gradients `d_ij` (1/m) and hourglass
+/// weights `ŵ_ij / |u_ij|²` (1/m²).
 struct PairChunk {
-    j: [u32; LANES],
     u: V4,
     d: V4,
     w: F4,
@@ -383,6 +383,10 @@ struct PairChunk {
 /// The rest data of a particle's pair slots (a whole number of chunks, see
 /// [`crate::neighbours::PAIR_SLOT_ALIGNMENT`]), four slots a chunk.
 struct PairChunks<'a> {
+    /// Above every neighbour index of `j` (of the slots these were split from, for a
+    /// [`PairChunks::sub`]): a field at least this long can be gathered from without a check
+    /// per index ([`PairChunks::gather`]).
+    bound: usize,
     j: &'a [[u32; LANES]],
     u: [&'a [[Real; LANES]]; 3],
     d: [&'a [[Real; LANES]]; 3],
@@ -399,8 +403,10 @@ impl<'a> PairChunks<'a> {
         }
         let (u, d) = (&nbr.rest_offset, &nbr.gradient);
         let s = slots;
+        let j = whole(&nbr.index[s.clone()]);
         let out = PairChunks {
-            j: whole(&nbr.index[s.clone()]),
+            bound: j.as_flattened().iter().fold(0, |m, &j| m.max(j)) as usize + 1,
+            j,
             u: [&u.x, &u.y, &u.z].map(|c| whole(&c[s.clone()])),
             d: [&d.x, &d.y, &d.z].map(|c| whole(&c[s.clone()])),
             w: whole(&nbr.hourglass_weight[s]),
@@ -413,6 +419,7 @@ impl<'a> PairChunks<'a> {
     #[inline(always)]
     fn sub(&self, chunks: Range<usize>) -> PairChunks<'a> {
         PairChunks {
+            bound: self.bound,
             j: &self.j[chunks.clone()],
             u: self.u.map(|a| &a[chunks.clone()]),
             d: self.d.map(|a| &a[chunks.clone()]),
@@ -423,6 +430,22 @@ impl<'a> PairChunks<'a> {
     fn len(&self) -> usize {
         self.j.len()
     }
+    /// Whether every neighbour index is below `len` (one comparison for all the chunks).
+    #[inline(always)]
+    fn indexes_below(&self, len: usize) -> bool {
+        self.bound <= len
+    }
+    /// `field[j]` for the four neighbours `j` of chunk `k`, where [`PairChunks::indexes_below`]
+    /// the field's length (checked by the caller, once for all its chunks).
+    ///
+    /// # Safety
+    /// `self.indexes_below(field.len())`.
+    #[inline(always)]
+    unsafe fn gather(&self, field: &[Vec3], k: usize) -> V4 {
+        // SAFETY: every index of `j` is below `bound` (computed from them, or from a superset
+        // for a sub-view), hence below the field's length (the caller's contract).
+        unsafe { V4::gather_unchecked(field, &self.j[k]) }
+    }
     #[inline(always)]
     fn get(&self, k: usize) -> PairChunk {
         let v = |c: &[&[[Real; LANES]]; 3]| V4 {
@@ -431,7 +454,6 @@ impl<'a> PairChunks<'a> {
             z: F4::new(c[2][k]),
         };
         PairChunk {
-            j: self.j[k],
             u: v(&self.u),
             d: v(&self.d),
             w: F4::new(self.w[k]),
@@ -505,9 +527,11 @@ fn gradient_pass(
     let offset = &mut offset[..rest.len()];
     let xi = V4::splat(&input.x[i]);
     let mut fsum = M4::default();
+    assert!(rest.indexes_below(input.x.len()));
     for (k, o) in offset.iter_mut().enumerate() {
         let c = rest.get(k);
-        *o = V4::gather(input.x, &c.j) - xi;
+        // SAFETY: checked before the loop.
+        *o = unsafe { rest.gather(input.x, k) } - xi;
         fsum.add_outer(&(*o - c.u), &c.d);
     }
     fsum.sum() + Mat3::identity()
@@ -549,6 +573,7 @@ fn pair_pass(
     // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
     let m = M4::splat(&(stress + qsum.sum()));
     let damping = model.damping_stiffness * model.p_wave_modulus() * vi;
+    assert!(damping <= 0.0 || rest.indexes_below(input.v.len()));
     let vel_i = V4::splat(&input.v[i]);
     let mut fi = V4::default();
     for (k, (o, eps)) in offset.iter().zip(residual.iter()).enumerate() {
@@ -557,7 +582,8 @@ fn pair_pass(
         if damping > 0.0 {
             // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
             let len2 = o.dot(o);
-            let rate = (V4::gather(input.v, &c.j) - vel_i).dot(o);
+            // SAFETY: checked before the loop (`damping > 0`).
+            let rate = (unsafe { rest.gather(input.v, k) } - vel_i).dot(o);
             let k2 = c.d.dot(&c.d);
             // Lanes of (nearly) coincident particles get no damping: their quotient (an
             // infinity or a NaN) is computed but not selected.
@@ -682,6 +708,58 @@ mod tests {
                     f[i][c]
                 );
             }
+        }
+    }
+
+    /// The gathers of the pair loops read without a check per index, after one check per
+    /// particle and field: positions or velocities that stop before a neighbour of the block (though
+    /// not before its own particles) are refused with a panic, never read past.
+    #[test]
+    fn fields_shorter_than_the_neighbourhoods_are_refused() {
+        let rest = jittered_block();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let n = rest.len();
+        let volume = vec![1.0; n];
+        let damped = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
+        let still = vec![Vec3::zeros(); n];
+        // The first block's farthest neighbour: fields that stop just before it.
+        let block = 0..LANES;
+        let far = nbr.index[nbr.offsets[0] as usize..nbr.offsets[LANES] as usize]
+            .iter()
+            .fold(0, |m, &j| m.max(j as usize));
+        assert!(far >= LANES, "a neighbour past the block's particles");
+        for (x, v) in [(&rest[..far], &still[..]), (&rest[..], &still[..far])] {
+            let input = ForceInputs {
+                nbr: &nbr,
+                volume: &volume,
+                x,
+                v,
+            };
+            let pass = ParticlePass {
+                model: &damped,
+                input: &input,
+                rotation_iterations: 50,
+            };
+            let run = std::panic::catch_unwind(|| {
+                let mut rotation = [Quat::identity(); LANES];
+                let mut pair_force = vec![Vec3::zeros(); nbr.offsets[LANES] as usize];
+                let mut own = [Vec3::zeros(); LANES];
+                let mut buffer = BlockBuffer::new();
+                block_pair_forces(
+                    &pass,
+                    block.start,
+                    &mut rotation,
+                    &mut buffer,
+                    &mut pair_force,
+                    &mut own,
+                );
+            });
+            assert!(
+                run.is_err(),
+                "{} positions, {} velocities",
+                x.len(),
+                v.len()
+            );
         }
     }
 

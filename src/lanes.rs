@@ -229,10 +229,14 @@ impl V4 {
             z: F4::splat(v.z),
         }
     }
-    /// `field[j[l]]` in lane `l`.
+    /// `field[j[l]]` in lane `l`, without a check per index.
+    ///
+    /// # Safety
+    /// Every `j[l]` is below `field.len()`.
     #[inline(always)]
-    pub(crate) fn gather(field: &[Vec3], j: &[u32; LANES]) -> V4 {
-        let at = |l: usize| &field[j[l] as usize];
+    pub(crate) unsafe fn gather_unchecked(field: &[Vec3], j: &[u32; LANES]) -> V4 {
+        // SAFETY: the caller's contract.
+        let at = |l: usize| unsafe { field.get_unchecked(j[l] as usize) };
         V4::from_refs([at(0), at(1), at(2), at(3)])
     }
     /// Lane `l` is `*a[l]`: four masked loads and a transpose with AVX, otherwise one
@@ -634,7 +638,8 @@ mod tests {
             .map(|k| Vec3::new(k as Real + 0.25, -(k as Real) - 0.5, 1e-300 * k as Real))
             .collect();
         let j = [6, 0, 3, 6];
-        let v = V4::gather(&field, &j);
+        // SAFETY: every index is below 7.
+        let v = unsafe { V4::gather_unchecked(&field, &j) };
         for (l, &k) in j.iter().enumerate() {
             let lane = |c: F4| c.to_array()[l];
             assert_eq!(
