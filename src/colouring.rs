@@ -2,7 +2,9 @@
 //! projection order: sorted by their smallest particle index. Particles are numbered along a
 //! Morton curve (`crate::particle_order`), so tetrahedra that are neighbours in this order are
 //! neighbours in space. The order is cut into blocks of [`BLOCK`] consecutive tetrahedra, each
-//! working on a compact region of nearby particles, in cache. The blocks are coloured so that
+//! working on a compact region of nearby particles, in cache; within a block, consecutive
+//! tetrahedra are made to share no particle where possible (so that one projection does not
+//! wait for the stores of the one before). The blocks are coloured so that
 //! blocks of one colour share no particle. The pass runs the colours in sequence and the
 //! blocks of a colour in any order, on any number of threads, each block's tetrahedra in
 //! their order: the result does not depend on the thread count.
@@ -41,6 +43,30 @@ pub(crate) struct TetColouring {
     particles: usize,
 }
 
+/// How far ahead in a block [`alternate`] looks for a tetrahedron that shares no particle with
+/// the one before.
+const ALTERNATE_WINDOW: usize = 32;
+
+/// Reorder `block` (tetrahedron indices into `tets`) so that consecutive tetrahedra share no
+/// particle where possible: each next one is the first of the following [`ALTERNATE_WINDOW`]
+/// that shares none with the one before, or the first if none does.
+///
+/// The projection of a tetrahedron reads the corners the one before it wrote: when they share
+/// one, it waits for those stores. A projection of four lanes is ~450 instructions, more than
+/// the processor's reorder window (320 on the machine of docs/PERFORMANCE.md), so only the
+/// tetrahedron just before can hold it up: one step apart is enough.
+fn alternate(block: &mut [u32], tets: &[[u32; 4]]) {
+    let mut left: Vec<u32> = block.to_vec();
+    for k in 0..block.len() {
+        let before = k.checked_sub(1).map(|p| tets[block[p] as usize]);
+        let shares =
+            |t: &u32| before.is_some_and(|b| tets[*t as usize].iter().any(|p| b.contains(p)));
+        let window = left.len().min(ALTERNATE_WINDOW);
+        let pick = left[..window].iter().position(|t| !shares(t)).unwrap_or(0);
+        block[k] = left.remove(pick);
+    }
+}
+
 impl TetColouring {
     /// Order and colour `tets` (4 particle indices each, all below `particles`: panics
     /// otherwise) with their rest volumes `rest_volume` (m³).
@@ -52,6 +78,9 @@ impl TetColouring {
         assert_eq!(tets.len(), rest_volume.len());
         let mut order: Vec<u32> = (0..tets.len() as u32).collect();
         order.sort_by_key(|&t| (tets[t as usize].iter().min().copied(), t));
+        for block in order.chunks_mut(BLOCK) {
+            alternate(block, tets);
+        }
         // Per colour, whether each particle is taken by one of its blocks.
         let mut taken: Vec<Vec<bool>> = Vec::new();
         let mut colour_of = Vec::new();
@@ -176,6 +205,35 @@ mod tests {
         }
         assert!(seen.iter().all(|&n| n == 1));
         c
+    }
+
+    /// Within a block, consecutive tetrahedra rarely share a particle (they nearly all do in
+    /// the sorted order), and each block holds the tetrahedra of the sorted order's block.
+    #[test]
+    fn consecutive_tetrahedra_of_a_block_rarely_share_a_particle() {
+        let mesh = lattice_box(Vec3::zeros(), Vec3::repeat(1.0), [12, 10, 11]);
+        let c = coloured(&mesh);
+        let share = |a: &[u32; 4], b: &[u32; 4]| a.iter().any(|k| b.contains(k));
+        let fraction = |tets: &[[u32; 4]]| {
+            let (mut pairs, mut shared) = (0, 0);
+            for block in tets.chunks(BLOCK) {
+                for w in block.windows(2) {
+                    pairs += 1;
+                    shared += usize::from(share(&w[0], &w[1]));
+                }
+            }
+            shared as Real / pairs as Real
+        };
+        let mut sorted = mesh.tets.clone();
+        sorted.sort_by_key(|t| *t.iter().min().unwrap());
+        assert!(fraction(&sorted) > 0.5, "sorted: {}", fraction(&sorted));
+        assert!(fraction(&c.tets) < 0.02, "reordered: {}", fraction(&c.tets));
+        for (ours, theirs) in c.tets.chunks(BLOCK).zip(sorted.chunks(BLOCK)) {
+            let (mut a, mut b) = (ours.to_vec(), theirs.to_vec());
+            a.sort();
+            b.sort();
+            assert_eq!(a, b);
+        }
     }
 
     /// The volume pass reads corners without a check per index: a tetrahedron naming a
