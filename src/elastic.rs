@@ -712,8 +712,8 @@ mod tests {
     }
 
     /// The gathers of the pair loops read without a check per index, after one check per
-    /// particle and field: positions or velocities that stop before a neighbour of the block (though
-    /// not before its own particles) are refused with a panic, never read past.
+    /// particle and field: positions or velocities that stop before a neighbour of the block
+    /// (though not before its own particles) are refused with a panic, never read past.
     #[test]
     fn fields_shorter_than_the_neighbourhoods_are_refused() {
         let rest = jittered_block();
