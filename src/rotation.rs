@@ -166,15 +166,6 @@ pub(crate) fn extract_rotations(f: &M4, q: &mut [Quat], newton_iterations: u32) 
             b.mul_sub(c, a * e),
             a.mul_sub(d, b * b),
         );
-        let det = V4 { x: a, y: b, z: c }.dot(&V4 {
-            x: m00,
-            y: m01,
-            z: m02,
-        });
-        let zero = F4::splat(0.0);
-        let indefinite = pending & (a.le(zero) | m22.le(zero) | det.le(zero));
-        failed = failed | indefinite;
-        pending = pending & !indefinite;
         let adjugate = M4 {
             rows: [
                 V4 {
@@ -194,6 +185,11 @@ pub(crate) fn extract_rotations(f: &M4, q: &mut [Quat], newton_iterations: u32) 
                 },
             ],
         };
+        let det = adjugate.rows[0].dot(&V4 { x: a, y: b, z: c });
+        let zero = F4::splat(0.0);
+        let indefinite = pending & (a.le(zero) | m22.le(zero) | det.le(zero));
+        failed = failed | indefinite;
+        pending = pending & !indefinite;
         let delta = adjugate.mul(&g).scale(F4::splat(1.0) / det);
         quat = Q4::select(pending, &quat.turned(&delta.scale(F4::splat(0.5))), &quat);
         short = pending
