@@ -29,7 +29,7 @@
 use crate::lanes::{F4, LANES, M4, V4};
 use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
-use crate::pair_sums::{self, PassA, TrailingSums, TRAIL_WINDOW};
+use crate::pair_sums::{self, Kept, ShareForces};
 use crate::parallel::{Barrier, Pool, SharedSlice};
 use crate::rotation::extract_rotations;
 use std::ops::Range;
@@ -105,12 +105,11 @@ pub struct ForceInputs<'a> {
 /// (one entry per pair slot) and `own_force` (one per particle) are scratch: no allocation inside.
 ///
 /// Every particle `i` computes its deformation gradient, rotation and stress and the force
-/// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). On one thread the pair forces
-/// are scattered as they are computed. On several, the particles are split into ranges: pass A
-/// stores every `g_ij` and each `Σ_j g_ij`; pass B has each particle `j` sum what concerns it in
-/// exactly the order of the scatter — pairs from particles before `j`, its own sum, pairs from
-/// particles after `j` — so the result is bit-identical for any number of threads. Pass B
-/// trails pass A within each share, the rest after a barrier ([`crate::pair_sums`]).
+/// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). The particles are split into
+/// one contiguous share per thread; each share runs its particles in order and scatters each
+/// term to a particle all of whose terms come from the share, and keeps the others for a sum
+/// after a barrier, in the same order ([`crate::pair_sums`]). Every force is so summed in the
+/// one-thread order: the result is bit-identical for any number of threads.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_forces(
     model: &ElasticModel,
@@ -122,18 +121,36 @@ pub fn accumulate_forces(
     force: &mut [Vec3],
     pool: &Pool,
 ) {
-    let nbr = input.nbr;
-    let n = nbr.particle_count();
-    let kernel = Kernel::detect();
     let pass = ParticlePass {
         model,
         input,
         rotation_iterations,
     };
-    if pool.threads() == 1 {
-        kernel.scatter(&pass, rotation, pair_force, force);
-        return;
-    }
+    accumulate_forces_in(
+        Kernel::detect(),
+        &pass,
+        rotation,
+        pair_force,
+        own_force,
+        force,
+        pool,
+    );
+}
+
+/// [`accumulate_forces`] with the particle loops of `kernel`.
+fn accumulate_forces_in(
+    kernel: Kernel,
+    pass: &ParticlePass<'_, '_>,
+    rotation: &mut [Quat],
+    pair_force: &mut [Vec3],
+    own_force: &mut [Vec3],
+    force: &mut [Vec3],
+    pool: &Pool,
+) {
+    let nbr = pass.input.nbr;
+    let n = nbr.particle_count();
+    assert!(rotation.len() == n && own_force.len() == n && force.len() == n);
+    assert_eq!(pair_force.len(), nbr.slot_count());
     let rotation = SharedSlice::new(rotation);
     let pairs = SharedSlice::new(pair_force);
     let own = SharedSlice::new(own_force);
@@ -143,34 +160,36 @@ pub fn accumulate_forces(
         let _guard = barrier.guard();
         let particles = pool.share(share, n);
         {
-            let first_pair = nbr.offsets[particles.start] as usize;
-            let last_pair = nbr.offsets[particles.end] as usize;
+            let slots = nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize;
             // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
-            let (rot, pf, own, f) = unsafe {
-                (
-                    rotation.range(particles.clone()),
-                    pairs.range(first_pair..last_pair),
-                    own.range(particles.clone()),
-                    forces.range(particles.clone()),
-                )
+            let mut out = unsafe {
+                ShareForces {
+                    nbr,
+                    share: particles.clone(),
+                    force: forces.range(particles.clone()),
+                    pair_force: pairs.range(slots),
+                    own: own.range(particles.clone()),
+                }
             };
-            let mut sums = TrailingSums::new(nbr, particles.clone(), TRAIL_WINDOW, f);
-            kernel.keep(&pass, particles.clone(), rot, pf, own, &mut sums);
+            // SAFETY: as above.
+            let rotation = unsafe { rotation.range(particles.clone()) };
+            kernel.share_pass(pass, rotation, &mut out);
+        }
+        if pool.threads() == 1 {
+            return; // one share: no particle crosses shares
         }
         barrier.wait();
-        // SAFETY: every share's pass A has finished: its results are only read from here on;
-        // each share writes only its own particles' forces.
-        let pass_a = unsafe {
-            PassA {
+        // SAFETY: every share's first pass has finished: what it kept is only read from here
+        // on; each share writes only its own particles' forces.
+        let kept = unsafe {
+            Kept {
                 pairs: pairs.read(0..nbr.slot_count()),
-                pair_base: 0,
                 own: own.read(0..n),
-                own_base: 0,
             }
         };
         // SAFETY: shares own disjoint particle ranges.
         let f = unsafe { forces.range(particles.clone()) };
-        pair_sums::sum_after_barrier(nbr, particles, TRAIL_WINDOW, f, pass_a);
+        pair_sums::sum_after_barrier(nbr, particles, f, kept);
     });
 }
 
@@ -181,78 +200,26 @@ struct ParticlePass<'a, 'b> {
     rotation_iterations: u32,
 }
 
-/// One thread: every particle's pair forces, scattered into `force` as they are computed
-/// (`+g_ij` on `i`, `−g_ij` on `j`, in particle order).
+/// The first pass of one share's particles (`out.share`, their rotations in `rotation`), a
+/// block of four at a time, each particle's results handed on in order
+/// ([`ShareForces::distribute`]).
 #[inline(always)]
-fn scatter_pass(
-    pass: &ParticlePass<'_, '_>,
-    rotation: &mut [Quat],
-    pair_force: &mut [Vec3],
-    force: &mut [Vec3],
-) {
+fn share_pass(pass: &ParticlePass<'_, '_>, rotation: &mut [Quat], out: &mut ShareForces<'_>) {
     let nbr = pass.input.nbr;
+    let share = out.share.clone();
     let mut buffer = BlockBuffer::new();
     let mut own = [Vec3::zeros(); LANES];
     for (block, q) in rotation.chunks_mut(LANES).enumerate() {
-        let particles = block * LANES..block * LANES + q.len();
-        let slots = nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize;
+        let first = share.start + block * LANES;
+        let particles = first..first + q.len();
+        let base = nbr.offsets[first] as usize;
         let own = &mut own[..q.len()];
-        block_pair_forces(
-            pass,
-            particles.start,
-            q,
-            &mut buffer,
-            &mut pair_force[slots],
-            own,
-        );
-        for (i, fi) in particles.zip(own.iter()) {
-            for (&j, g) in nbr.index[nbr.range(i)]
-                .iter()
-                .zip(&pair_force[nbr.slots(i)])
-            {
-                force[j as usize] -= g;
-            }
-            force[i] += fi;
+        block_pair_forces(pass, first, q, &mut buffer, own);
+        for (i, &fi) in particles.zip(own.iter()) {
+            let s = nbr.slots(i);
+            let chunks = (s.start - base) / LANES..(s.end - base) / LANES;
+            out.distribute(i, buffer.pair_force[chunks].as_flattened(), fi);
         }
-    }
-}
-
-/// Pass A of several threads, one share: the pair forces of the particles `particles` kept in
-/// `pair_force` (their slots, from the first particle's) and their sums in `own`, with the
-/// trailing pass B in `sums` (see [`crate::pair_sums`]).
-#[inline(always)]
-fn keep_pass(
-    pass: &ParticlePass<'_, '_>,
-    particles: Range<usize>,
-    rotation: &mut [Quat],
-    pair_force: &mut [Vec3],
-    own: &mut [Vec3],
-    sums: &mut TrailingSums<'_>,
-) {
-    let nbr = pass.input.nbr;
-    let first_pair = nbr.offsets[particles.start] as usize;
-    let mut buffer = BlockBuffer::new();
-    for block in 0..rotation.len().div_ceil(LANES) {
-        let first = particles.start + block * LANES;
-        let done = (first + LANES).min(particles.end);
-        let slots =
-            nbr.offsets[first] as usize - first_pair..nbr.offsets[done] as usize - first_pair;
-        let local = first - particles.start..done - particles.start;
-        block_pair_forces(
-            pass,
-            first,
-            &mut rotation[local.clone()],
-            &mut buffer,
-            &mut pair_force[slots],
-            &mut own[local],
-        );
-        let pass_a = PassA {
-            pairs: pair_force,
-            pair_base: first_pair,
-            own,
-            own_base: particles.start,
-        };
-        sums.advance(done, pass_a);
     }
 }
 
@@ -285,39 +252,18 @@ impl Kernel {
         Kernel::Build
     }
 
-    /// [`scatter_pass`] in this kernel's copy.
-    fn scatter(
+    /// [`share_pass`] in this kernel's copy.
+    fn share_pass(
         self,
         pass: &ParticlePass<'_, '_>,
         rotation: &mut [Quat],
-        pair_force: &mut [Vec3],
-        force: &mut [Vec3],
+        out: &mut ShareForces<'_>,
     ) {
         match self {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `detect` returns `Avx512` only on a processor with AVX-512 F and VL.
-            Kernel::Avx512 => unsafe { avx512::scatter_pass(pass, rotation, pair_force, force) },
-            _ => scatter_pass(pass, rotation, pair_force, force),
-        }
-    }
-
-    /// [`keep_pass`] in this kernel's copy.
-    fn keep(
-        self,
-        pass: &ParticlePass<'_, '_>,
-        particles: Range<usize>,
-        rotation: &mut [Quat],
-        pair_force: &mut [Vec3],
-        own: &mut [Vec3],
-        sums: &mut TrailingSums<'_>,
-    ) {
-        match self {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `scatter`.
-            Kernel::Avx512 => unsafe {
-                avx512::keep_pass(pass, particles, rotation, pair_force, own, sums)
-            },
-            _ => keep_pass(pass, particles, rotation, pair_force, own, sums),
+            Kernel::Avx512 => unsafe { avx512::share_pass(pass, rotation, out) },
+            _ => share_pass(pass, rotation, out),
         }
     }
 }
@@ -328,34 +274,23 @@ mod avx512 {
     use super::*;
 
     #[target_feature(enable = "avx512f,avx512vl")]
-    pub(super) fn scatter_pass(
+    pub(super) fn share_pass(
         pass: &ParticlePass<'_, '_>,
         rotation: &mut [Quat],
-        pair_force: &mut [Vec3],
-        force: &mut [Vec3],
+        out: &mut ShareForces<'_>,
     ) {
-        super::scatter_pass(pass, rotation, pair_force, force)
-    }
-
-    #[target_feature(enable = "avx512f,avx512vl")]
-    pub(super) fn keep_pass(
-        pass: &ParticlePass<'_, '_>,
-        particles: Range<usize>,
-        rotation: &mut [Quat],
-        pair_force: &mut [Vec3],
-        own: &mut [Vec3],
-        sums: &mut TrailingSums<'_>,
-    ) {
-        super::keep_pass(pass, particles, rotation, pair_force, own, sums)
+        super::share_pass(pass, rotation, out)
     }
 }
 
-/// Pair data held between the passes of [`block_pair_forces`], four pair slots a chunk: the
-/// current offsets `x_ij` (m) of a block's particles, and the hourglass residuals `ε_ij` (m) of
-/// one particle.
+/// Pair data of [`block_pair_forces`], four pair slots a chunk: held between its passes, the
+/// current offsets `x_ij` (m) of a block's particles and the hourglass residuals `ε_ij` (m) of
+/// one particle; its result, the pair forces of the block's particles.
 struct BlockBuffer {
     offset: [V4; LANES * MAX_CHUNKS],
     residual: [V4; MAX_CHUNKS],
+    /// The forces `g_ij` (N) of the block's pair slots, four a chunk, zero for the padding.
+    pair_force: [[Vec3; LANES]; LANES * MAX_CHUNKS],
 }
 
 /// Chunks of four pair slots a particle may have: the largest neighbourhood that
@@ -367,6 +302,7 @@ impl BlockBuffer {
         BlockBuffer {
             offset: [V4::default(); LANES * MAX_CHUNKS],
             residual: [V4::default(); MAX_CHUNKS],
+            pair_force: [[Vec3::zeros(); LANES]; LANES * MAX_CHUNKS],
         }
     }
 }
@@ -463,8 +399,9 @@ impl<'a> PairChunks<'a> {
 
 /// The first pass of the particles `first..first + rotation.len()` (a block of at most
 /// [`LANES`]): their deformation gradients, rotations (warm-started in `rotation`) and stresses,
-/// the force `g_ij` on `i` of each of their pair slots written to `pair_force` (the block's
-/// slots; zero for the padding), and each particle's sum in `own`.
+/// the force `g_ij` on `i` of each of their pair slots written to `buffer.pair_force` (the
+/// block's slots, from the first particle's; zero for the padding), and each particle's sum in
+/// `own`.
 ///
 /// Per particle, three passes over its slots, four at a time (see [`crate::lanes`]); the
 /// rotations and stresses of the block's particles in lanes, one a lane. A padding slot
@@ -476,7 +413,6 @@ fn block_pair_forces(
     first: usize,
     rotation: &mut [Quat],
     buffer: &mut BlockBuffer,
-    pair_force: &mut [Vec3],
     own: &mut [Vec3],
 ) {
     let (model, input) = (pass.model, pass.input);
@@ -499,7 +435,6 @@ fn block_pair_forces(
     let f4 = M4::from_matrices(&f);
     let r4 = extract_rotations(&f4, rotation, pass.rotation_iterations);
     let stress = corotated_stress(&f4, &r4, model.lambda, model.mu).scale(F4::new(volume));
-    let pair_force = pair_force.as_chunks_mut::<LANES>().0;
     for (l, i) in particles.enumerate() {
         let c = chunks(i);
         own[l] = pair_pass(
@@ -509,7 +444,7 @@ fn block_pair_forces(
             (&f[l], &stress.lane(l)),
             &buffer.offset[c.clone()],
             &mut buffer.residual,
-            &mut pair_force[c],
+            &mut buffer.pair_force[c],
         );
     }
 }
@@ -742,17 +677,9 @@ mod tests {
             };
             let run = std::panic::catch_unwind(|| {
                 let mut rotation = [Quat::identity(); LANES];
-                let mut pair_force = vec![Vec3::zeros(); nbr.offsets[LANES] as usize];
                 let mut own = [Vec3::zeros(); LANES];
                 let mut buffer = BlockBuffer::new();
-                block_pair_forces(
-                    &pass,
-                    block.start,
-                    &mut rotation,
-                    &mut buffer,
-                    &mut pair_force,
-                    &mut own,
-                );
+                block_pair_forces(&pass, block.start, &mut rotation, &mut buffer, &mut own);
             });
             assert!(
                 run.is_err(),
@@ -763,9 +690,10 @@ mod tests {
         }
     }
 
-    /// The AVX-512 copy of the particle loops gives the same bits as the build's own, in the
-    /// scattering (one thread) and the keeping (several) loop, with hourglass control and
-    /// damping on. On a processor without AVX-512 there is only one copy: nothing to compare.
+    /// The AVX-512 copy of the particle loops gives the same bits as the build's own, on one
+    /// thread and on three (where pair forces are kept and summed after the barrier), with
+    /// hourglass control and damping on. On a processor without AVX-512 there is only one
+    /// copy: nothing to compare.
     #[test]
     fn every_kernel_gives_the_same_bits() {
         if Kernel::detect() == Kernel::Build {
@@ -793,38 +721,31 @@ mod tests {
             input: &input,
             rotation_iterations: 50,
         };
-        let run = |kernel: Kernel| {
+        let run = |kernel: Kernel, threads: usize| {
             let mut rotation = vec![Quat::identity(); n];
             let mut pair_force = vec![Vec3::zeros(); nbr.slot_count()];
-            let mut force = vec![Vec3::zeros(); n];
-            kernel.scatter(&pass, &mut rotation, &mut pair_force, &mut force);
-            let mut kept_rotation = vec![Quat::identity(); n];
-            let mut kept = vec![Vec3::zeros(); nbr.slot_count()];
             let mut own = vec![Vec3::zeros(); n];
-            let mut summed = vec![Vec3::zeros(); n];
-            let mut sums = TrailingSums::new(&nbr, 0..n, TRAIL_WINDOW, &mut summed);
-            kernel.keep(
+            let mut force = vec![Vec3::zeros(); n];
+            let pool = Pool::new(threads);
+            accumulate_forces_in(
+                kernel,
                 &pass,
-                0..n,
-                &mut kept_rotation,
-                &mut kept,
+                &mut rotation,
+                &mut pair_force,
                 &mut own,
-                &mut sums,
+                &mut force,
+                &pool,
             );
-            let pass_a = PassA {
-                pairs: &kept,
-                pair_base: 0,
-                own: &own,
-                own_base: 0,
-            };
-            pair_sums::sum_after_barrier(&nbr, 0..n, TRAIL_WINDOW, &mut summed, pass_a);
-            assert_eq!(kept, pair_force);
-            assert_eq!(summed, force);
-            (force, rotation, own)
+            (force, rotation)
         };
-        let (force, rotation, own) = run(Kernel::Build);
+        let (force, rotation) = run(Kernel::Build, 1);
         assert!(force.iter().any(|f| f.norm() > 0.0));
-        assert_eq!(run(Kernel::Avx512), (force, rotation, own));
+        for threads in [1, 3] {
+            assert_eq!(
+                run(Kernel::Avx512, threads),
+                (force.clone(), rotation.clone())
+            );
+        }
     }
 
     /// The pair dashpot: a rigid rotation's velocities give no damping force, and a

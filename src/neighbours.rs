@@ -64,8 +64,13 @@ pub struct Neighbourhoods {
     pub incoming: Vec<u32>,
     /// `sources[j]`: the first and the last of the particles whose pairs particle `j`'s force
     /// sum reads, the particles that have `j` as a neighbour and `j` itself (length:
-    /// particles). The multi-thread force pass sums `j` once they are done.
+    /// particles). A thread whose share of the particles holds them scatters `j`'s terms itself
+    /// ([`crate::pair_sums`]).
     pub sources: Vec<[u32; 2]>,
+    /// `reach[i]`: the first and the last of the sources of particle `i` and of its neighbours
+    /// (length: particles). A share that holds them scatters every term of `i` itself, with no
+    /// check per pair.
+    pub reach: Vec<[u32; 2]>,
 }
 
 impl Neighbourhoods {
@@ -144,6 +149,7 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
         incoming_offsets: Vec::new(),
         incoming: Vec::new(),
         sources: (0..n as u32).map(|j| [j, j]).collect(),
+        reach: Vec::new(),
     };
     out.offsets.push(0);
     let mut candidates: Vec<(Real, u32)> = Vec::new();
@@ -251,6 +257,15 @@ pub fn build(rest: &[Vec3], support: SupportRadius) -> Result<Neighbourhoods, Ne
             *last = (*last).max(i as u32);
         }
     }
+    out.reach = (0..n)
+        .map(|i| {
+            let neighbours = out.index[out.range(i)].iter().map(|&j| j as usize);
+            neighbours.fold(out.sources[i], |[first, last], j| {
+                let [a, b] = out.sources[j];
+                [first.min(a), last.max(b)]
+            })
+        })
+        .collect();
     Ok(out)
 }
 
@@ -412,7 +427,7 @@ mod tests {
 
     /// Each particle's slots start on a chunk boundary and hold its pairs then at most three
     /// inert padding slots (neighbour itself, zero rest data); the transposed lists, the
-    /// sources and the pair count see only the real pairs.
+    /// sources, their reach and the pair count see only the real pairs.
     #[test]
     fn pair_slots_are_chunk_aligned_and_padding_is_inert() {
         let rest = jittered_lattice();
@@ -457,6 +472,17 @@ mod tests {
                 sources = [sources[0].min(owner), sources[1].max(owner)];
             }
             assert_eq!(nbr.sources[j].map(|k| k as usize), sources, "particle {j}");
+        }
+        for i in 0..rest.len() {
+            let mut reached = vec![i];
+            reached.extend(nbr.index[nbr.range(i)].iter().map(|&j| j as usize));
+            let first = reached.iter().map(|&j| nbr.sources[j][0]).min();
+            let last = reached.iter().map(|&j| nbr.sources[j][1]).max();
+            assert_eq!(
+                Some(nbr.reach[i]),
+                first.zip(last).map(|(a, b)| [a, b]),
+                "{i}"
+            );
         }
     }
 }

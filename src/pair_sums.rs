@@ -1,132 +1,112 @@
-//! Pass B of the force pass on several threads: each particle `j` sums the forces of the pairs
-//! that concern it, `−g_ij` of every pair `(i, j)` and its own `Σ_k g_jk`, in exactly the order
-//! of the one-thread scatter (pairs from particles before `j`, its own sum, pairs from
-//! particles after `j`), so that the result is bit-identical for any number of threads.
+//! How the pair forces of the force pass reach the particles' sums, bit-identically for any
+//! number of threads.
 //!
-//! The sums trail pass A within each share. Read back after the whole of pass A, the pair
-//! forces (24 bytes each, ~20 a particle, scattered over the arrays) came from the last-level
-//! cache or from memory: on liver_31k that took 2.0 ms of a 7.7 ms step, 5× liver_4k's cost
-//! per particle. Now a share sums particle `j` as soon as its own pass A has done every
-//! particle `j` reads ([`Neighbourhoods::sources`]), while their forces are still in the
-//! core's cache. A particle that reads a particle of another share, or one more than
-//! [`TRAIL_WINDOW`] ahead of it, is summed after a barrier that every share's pass A reaches:
-//! waiting for it would hold back the particles behind it.
+//! The force on particle `j` is what else acts on it, minus `g_ij` of every pair `(i, j)` and
+//! plus its own `Σ_k g_jk`, added in the order of the one-thread scatter: pairs from particles
+//! before `j`, its own sum, pairs from particles after `j`. Each thread's share of the
+//! particles runs the first pass in particle order, so a particle all of whose sources
+//! ([`Neighbourhoods::sources`]) lie in the share gets its terms in exactly that order when the
+//! share scatters them as they are computed ([`ShareForces::distribute`]). Only a particle with
+//! a source in another share needs its terms kept: they are written to the pair slots and
+//! summed, in the same order, after a barrier that every share's first pass reaches
+//! ([`sum_after_barrier`]). On one thread nothing is kept.
+//!
+//! Keeping every pair force (24 bytes a pair slot) and summing every particle from them, as an
+//! earlier version did, streamed the pair forces through memory on the large livers: on
+//! liver_31k ~15 MB written and read back a step, next to the ~37 MB of rest data.
 
 use crate::math::Vec3;
 use crate::neighbours::Neighbourhoods;
 use std::ops::Range;
 
-/// How far ahead of a particle (in particle order) its last source may be for the particle to
-/// be summed while pass A goes on. The particles behind it wait that long while pass A moves
-/// ~1.7 kB a particle (rest data read, pair forces written): 2048 particles are ~3.5 MB, a
-/// ninth of the reference machine's 32 MB last-level cache, so what the waiting particles
-/// read is still there. (A core's 1 MB L2 cannot hold the window in any case: a particle's
-/// first source is often hundreds of particles behind it along the Morton curve.)
-pub(crate) const TRAIL_WINDOW: usize = 2048;
-
-/// Whether particle `j` of the share of particles `share` is summed after the barrier: it
-/// reads a particle of another share, or one more than `window` ahead (in production
-/// [`TRAIL_WINDOW`]).
-#[inline]
-fn after_barrier(nbr: &Neighbourhoods, j: usize, share: &Range<usize>, window: usize) -> bool {
+/// Whether particle `j` has a source outside the particles `share`: its sum is then taken from
+/// the kept pair forces after the barrier, not scattered by the share.
+#[inline(always)]
+fn crosses(nbr: &Neighbourhoods, j: usize, share: &Range<usize>) -> bool {
     let [first, last] = nbr.sources[j].map(|k| k as usize);
-    first < share.start || last >= share.end || last >= j + window
+    first < share.start || last >= share.end
 }
 
-/// The pair forces and own sums (N) of pass A that a sum reads: pair `e`'s force is
-/// `pairs[e - pair_base]`, particle `i`'s own sum `own[i - own_base]`.
-#[derive(Clone, Copy)]
-pub(crate) struct PassA<'a> {
-    pub(crate) pairs: &'a [Vec3],
-    pub(crate) pair_base: usize,
-    pub(crate) own: &'a [Vec3],
-    pub(crate) own_base: usize,
+/// The results of one share's first pass.
+pub(crate) struct ShareForces<'a> {
+    /// The neighbourhoods of the whole body.
+    pub(crate) nbr: &'a Neighbourhoods,
+    /// The share's particles.
+    pub(crate) share: Range<usize>,
+    /// Forces on the share's particles (N), particle `j` at `j - share.start`: on entry what
+    /// else acts on them.
+    pub(crate) force: &'a mut [Vec3],
+    /// The share's pair slots (from its first particle's), pair `e` at
+    /// `e - offsets[share.start]`: the forces `g_ij` (N) of the pairs whose neighbour `j`
+    /// crosses shares.
+    pub(crate) pair_force: &'a mut [Vec3],
+    /// The own sums `Σ_k g_ik` (N) of the share's particles that cross shares, particle `i` at
+    /// `i - share.start`.
+    pub(crate) own: &'a mut [Vec3],
 }
 
-/// The sums of one share's particles that trail its pass A.
-pub(crate) struct TrailingSums<'a> {
-    nbr: &'a Neighbourhoods,
-    share: Range<usize>,
-    window: usize,
-    /// The next particle to look at.
-    next: usize,
-    /// A ready particle held back to be summed beside the next one.
-    held: Option<usize>,
-    /// The share's forces (N), particle `j` at `j - share.start`: on entry what else acts on
-    /// the particles.
-    force: &'a mut [Vec3],
-}
-
-impl<'a> TrailingSums<'a> {
-    /// The trailing sums of the particles `share`, added to `force` (theirs, N), leaving to
-    /// the barrier the particles whose last source is `window` or more ahead.
-    pub(crate) fn new(
-        nbr: &'a Neighbourhoods,
-        share: Range<usize>,
-        window: usize,
-        force: &'a mut [Vec3],
-    ) -> Self {
-        assert_eq!(force.len(), share.len());
-        TrailingSums {
-            nbr,
-            next: share.start,
-            share,
-            window,
-            held: None,
-            force,
-        }
-    }
-
-    /// Sum every particle not yet summed, not left for the barrier, whose sources are all
-    /// before `done`, now that the share's pass A has done the particles before `done`, in
-    /// `pass_a` (the share's pair slots and own sums). At `done` = the share's end, every
-    /// particle not left for the barrier is summed.
-    #[inline]
-    pub(crate) fn advance(&mut self, done: usize, pass_a: PassA<'_>) {
+impl ShareForces<'_> {
+    /// Hand on the first pass's results for particle `i` of the share, whose particles before
+    /// `i` have had theirs: `pairs`, the forces `g_ij` (N) of its pair slots, padding included,
+    /// and `own`, their sum. Each term goes to the force of a particle that crosses no share,
+    /// or is kept for [`ShareForces::sum_after_barrier`].
+    #[inline(always)]
+    pub(crate) fn distribute(&mut self, i: usize, pairs: &[Vec3], own: Vec3) {
         let nbr = self.nbr;
-        while self.next < self.share.end {
-            let j = self.next;
-            if !after_barrier(nbr, j, &self.share, self.window) {
-                if nbr.sources[j][1] as usize >= done {
-                    break;
-                }
-                match self.held.take() {
-                    None => self.held = Some(j),
-                    Some(i) => sum_two(nbr, [i, j], pass_a, self.force, self.share.start),
-                }
+        let start = self.share.start;
+        let range = nbr.range(i);
+        let [first, last] = nbr.reach[i].map(|k| k as usize);
+        if first >= start && last < self.share.end {
+            // Nothing of i's crosses shares (always so on one thread).
+            for (&j, g) in nbr.index[range].iter().zip(pairs) {
+                self.force[j as usize - start] -= g;
             }
-            self.next += 1;
+            self.force[i - start] += own;
+            return;
         }
-        if done >= self.share.end {
-            if let Some(i) = self.held.take() {
-                sum_two(nbr, [i, i], pass_a, self.force, self.share.start);
+        let first_pair = nbr.offsets[start] as usize;
+        for ((e, &j), g) in range.clone().zip(&nbr.index[range]).zip(pairs) {
+            let j = j as usize;
+            if crosses(nbr, j, &self.share) {
+                self.pair_force[e - first_pair] = *g;
+            } else {
+                self.force[j - start] -= g;
             }
+        }
+        if crosses(nbr, i, &self.share) {
+            self.own[i - start] = own;
+        } else {
+            self.force[i - start] += own;
         }
     }
 }
 
-/// After the barrier: the sums of the particles of `share` left for it (`window` as in
-/// [`TrailingSums::new`]), added to `force` (theirs, N), reading every share's pass A in
-/// `pass_a`.
+/// The kept results of every share's first pass, read after the barrier: pair `e`'s force
+/// `pairs[e]` and particle `i`'s own sum `own[i]` (N), written where the pair's neighbour or the
+/// particle crosses shares.
+#[derive(Clone, Copy)]
+pub(crate) struct Kept<'a> {
+    pub(crate) pairs: &'a [Vec3],
+    pub(crate) own: &'a [Vec3],
+}
+
+/// After the barrier: the sums of the particles of `share` that cross shares, added to
+/// `force` (theirs, N), from every share's kept results.
 pub(crate) fn sum_after_barrier(
     nbr: &Neighbourhoods,
     share: Range<usize>,
-    window: usize,
     force: &mut [Vec3],
-    pass_a: PassA<'_>,
+    kept: Kept<'_>,
 ) {
     let mut held = None;
-    for j in share
-        .clone()
-        .filter(|&j| after_barrier(nbr, j, &share, window))
-    {
+    for j in share.clone().filter(|&j| crosses(nbr, j, &share)) {
         match held.take() {
             None => held = Some(j),
-            Some(i) => sum_two(nbr, [i, j], pass_a, force, share.start),
+            Some(i) => sum_two(nbr, [i, j], kept, force, share.start),
         }
     }
     if let Some(i) = held {
-        sum_two(nbr, [i, i], pass_a, force, share.start);
+        sum_two(nbr, [i, i], kept, force, share.start);
     }
 }
 
@@ -134,13 +114,7 @@ pub(crate) fn sum_after_barrier(
 /// Each sum is a chain of dependent additions; two side by side keep the adder busy, each in
 /// its own order.
 #[inline(always)]
-fn sum_two(
-    nbr: &Neighbourhoods,
-    j: [usize; 2],
-    pass_a: PassA<'_>,
-    force: &mut [Vec3],
-    first: usize,
-) {
+fn sum_two(nbr: &Neighbourhoods, j: [usize; 2], kept: Kept<'_>, force: &mut [Vec3], first: usize) {
     let split = |j: usize| {
         // Pairs of particles before j have indices below offsets[j].
         let incoming = nbr.incoming(j);
@@ -148,18 +122,18 @@ fn sum_two(
     };
     let [(before0, after0), (before1, after1)] = j.map(split);
     let mut sums = j.map(|j| force[j - first]);
-    subtract_pairs(&mut sums, [before0, before1], pass_a);
-    sums[0] += pass_a.own[j[0] - pass_a.own_base];
-    sums[1] += pass_a.own[j[1] - pass_a.own_base];
-    subtract_pairs(&mut sums, [after0, after1], pass_a);
+    subtract_pairs(&mut sums, [before0, before1], kept);
+    sums[0] += kept.own[j[0]];
+    sums[1] += kept.own[j[1]];
+    subtract_pairs(&mut sums, [after0, after1], kept);
     force[j[0] - first] = sums[0];
     force[j[1] - first] = sums[1];
 }
 
 /// `sums[s] -= g_e` for the pairs `e` of `lists[s]` in order, the two lists side by side.
 #[inline(always)]
-fn subtract_pairs(sums: &mut [Vec3; 2], lists: [&[u32]; 2], pass_a: PassA<'_>) {
-    let pair = |e: u32| &pass_a.pairs[e as usize - pass_a.pair_base];
+fn subtract_pairs(sums: &mut [Vec3; 2], lists: [&[u32]; 2], kept: Kept<'_>) {
+    let pair = |e: u32| &kept.pairs[e as usize];
     let common = lists[0].len().min(lists[1].len());
     let (head0, tail0) = lists[0].split_at(common);
     let (head1, tail1) = lists[1].split_at(common);
@@ -181,11 +155,12 @@ mod tests {
     use crate::math::Real;
     use crate::neighbours::{build, SupportRadius};
 
-    /// Three shares of a lattice body, pass A's results revealed four particles at a time: the
-    /// trailing sums and those after the barrier give exactly the bits of the one-thread
-    /// scatter, and never read a result before pass A has written it (unwritten ones are NaN).
+    /// Shares of a lattice body, each handing on its particles' results in order: the forces
+    /// after the barrier are exactly the bits of the one-thread scatter, in three shares (with
+    /// particles that cross shares and particles that do not in each) and in one (where nothing
+    /// is kept: what was not written stays NaN, and a sum that read it would be NaN).
     #[test]
-    fn trailing_and_barrier_sums_give_the_scatter_bits() {
+    fn shares_give_the_scatter_bits() {
         let side = 8;
         let mut rest = Vec::new();
         for k in 0..side * side * side {
@@ -215,58 +190,54 @@ mod tests {
             }
             expected[i] += own[i];
         }
-        // Row-major lattice order: a particle's neighbours lie up to a layer (64) and a row
-        // (8) on either side, so this window leaves some particles to the barrier.
-        let window = 64;
-        let shares = [0..170, 170..341, 341..n];
-        let mut force = external.clone();
-        let (mut trailing, mut by_window) = (0, 0);
-        for share in shares.clone() {
-            let slots = nbr.offsets[share.start] as usize..nbr.offsets[share.end] as usize;
-            let mut written_pairs = vec![Vec3::repeat(Real::NAN); slots.len()];
-            let mut written_own = vec![Vec3::repeat(Real::NAN); share.len()];
-            let mut sums =
-                TrailingSums::new(&nbr, share.clone(), window, &mut force[share.clone()]);
-            for first in share.clone().step_by(4) {
-                let done = (first + 4).min(share.end);
-                for i in first..done {
-                    written_own[i - share.start] = own[i];
-                    for e in nbr.slots(i) {
-                        written_pairs[e - slots.start] = pairs[e];
-                    }
-                }
-                let pass_a = PassA {
-                    pairs: &written_pairs,
-                    pair_base: slots.start,
-                    own: &written_own,
-                    own_base: share.start,
+        let nan = Vec3::repeat(Real::NAN);
+        let run = |shares: &[Range<usize>]| {
+            let mut force = external.clone();
+            let mut kept_pairs = vec![nan; nbr.slot_count()];
+            let mut kept_own = vec![nan; n];
+            // Shares are independent until the barrier: one after the other here.
+            for share in shares {
+                let slots = nbr.offsets[share.start] as usize..nbr.offsets[share.end] as usize;
+                let mut out = ShareForces {
+                    nbr: &nbr,
+                    share: share.clone(),
+                    force: &mut force[share.clone()],
+                    pair_force: &mut kept_pairs[slots],
+                    own: &mut kept_own[share.clone()],
                 };
-                sums.advance(done, pass_a);
+                for i in share.clone() {
+                    out.distribute(i, &pairs[nbr.slots(i)], own[i]);
+                }
             }
-            for j in share.clone() {
-                let [first, last] = nbr.sources[j].map(|k| k as usize);
-                let inside = first >= share.start && last < share.end;
-                trailing += usize::from(!after_barrier(&nbr, j, &share, window));
-                by_window += usize::from(inside && last >= j + window);
+            let kept = Kept {
+                pairs: &kept_pairs,
+                own: &kept_own,
+            };
+            for share in shares {
+                sum_after_barrier(&nbr, share.clone(), &mut force[share.clone()], kept);
             }
-        }
-        let pass_a = PassA {
-            pairs: &pairs,
-            pair_base: 0,
-            own: &own,
-            own_base: 0,
+            for j in 0..n {
+                assert_eq!(force[j], expected[j], "particle {j}, shares {shares:?}");
+            }
+            let crossing = shares
+                .iter()
+                .map(|share| share.clone().filter(|&j| crosses(&nbr, j, share)).count())
+                .collect::<Vec<_>>();
+            let untouched = kept_pairs.iter().chain(&kept_own).all(|g| g.x.is_nan());
+            (crossing, untouched)
         };
-        for share in shares {
-            let mine = &mut force[share.clone()];
-            sum_after_barrier(&nbr, share, window, mine, pass_a);
+        // Row-major lattice order: a particle's neighbours lie up to a layer (64 particles)
+        // and a row (8) on either side, so the particles near a share's ends cross.
+        let shares = [0..170, 170..341, 341..n];
+        let (crossing, untouched) = run(&shares);
+        for (share, &count) in shares.iter().zip(&crossing) {
+            assert!(
+                count > 10 && count + 10 < share.len(),
+                "{crossing:?} of {shares:?} cross"
+            );
         }
-        assert!(
-            trailing > 20 && by_window > 20,
-            "{trailing} trailing, {by_window} by the window"
-        );
-        assert!(trailing + by_window < n, "no particle of another share's");
-        for j in 0..n {
-            assert_eq!(force[j], expected[j], "particle {j}");
-        }
+        assert!(!untouched);
+        let whole = 0..n;
+        assert_eq!(run(std::slice::from_ref(&whole)), (vec![0], true));
     }
 }

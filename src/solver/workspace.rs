@@ -16,9 +16,10 @@ pub(crate) struct StepScratch {
     pub(crate) p: Vec<Vec3>,
     /// Forces of the current substep (N).
     pub(crate) force: Vec<Vec3>,
-    /// Per-pair forces of the force computation (N), one entry per neighbour pair.
+    /// Pair forces of the force pass (N), one entry per pair slot: on several threads, those
+    /// kept for the particles summed after its barrier (`crate::pair_sums`).
     pub(crate) pair_force: Vec<Vec3>,
-    /// Per-particle sums of their pair forces (N), for the multi-threaded force pass.
+    /// The particles' sums of their pair forces (N), kept as `pair_force` is.
     pub(crate) own_force: Vec<Vec3>,
     /// XPBD multipliers of the volume constraints within a substep, one per load-time
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones).
