@@ -49,7 +49,7 @@ impl ShareForces<'_> {
     /// Hand on the first pass's results for particle `i` of the share, whose particles before
     /// `i` have had theirs: `pairs`, the forces `g_ij` (N) of its pair slots, padding included,
     /// and `own`, their sum. Each term goes to the force of a particle that crosses no share,
-    /// or is kept for [`ShareForces::sum_after_barrier`].
+    /// or is kept for [`sum_after_barrier`].
     #[inline(always)]
     pub(crate) fn distribute(&mut self, i: usize, pairs: &[Vec3], own: Vec3) {
         let nbr = self.nbr;
