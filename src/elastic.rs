@@ -508,28 +508,82 @@ fn pair_pass(
     // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
     let m = M4::splat(&(stress + qsum.sum()));
     let damping = model.damping_stiffness * model.p_wave_modulus() * vi;
-    assert!(damping <= 0.0 || rest.indexes_below(input.v.len()));
-    let vel_i = V4::splat(&input.v[i]);
+    let data = PairForceData {
+        rest,
+        m: &m,
+        c_scale,
+        offset,
+        residual,
+    };
+    let fi = if damping > 0.0 {
+        let dashpot = Dashpot {
+            damping: F4::splat(damping),
+            v: input.v,
+            vel_i: V4::splat(&input.v[i]),
+        };
+        pair_forces::<true>(&data, &dashpot, pair_force)
+    } else {
+        let none = Dashpot {
+            damping: F4::splat(0.0),
+            v: &[],
+            vel_i: V4::default(),
+        };
+        pair_forces::<false>(&data, &none, pair_force)
+    };
+    fi.sum()
+}
+
+/// What pass 3 of one particle reads (see [`pair_pass`]): the rest data of its slots, `v_i P +
+/// Q` (N·m) splatted, the hourglass scale `c v_i` (N/m · m²) and the offsets `x_ij` (m) and
+/// residuals `ε_ij` (m) of passes 1 and 2.
+struct PairForceData<'a, 'r> {
+    rest: &'a PairChunks<'r>,
+    m: &'a M4,
+    c_scale: F4,
+    offset: &'a [V4],
+    residual: &'a [V4],
+}
+
+/// The pair dashpot of one particle: its damping coefficient `β (λ + 2μ) v_i` (N·s/m · m²,
+/// splatted), the velocities `v` (m/s) its neighbours are gathered from and its own `v_i`.
+struct Dashpot<'a> {
+    damping: F4,
+    v: &'a [Vec3],
+    vel_i: V4,
+}
+
+/// Pass 3 of one particle: the force `g_ij` (N) of each pair slot written to `pair_force`,
+/// their sum returned; with the dashpot where `DAMPED`. The two copies keep the test out of
+/// the loop, which has no free register for it.
+#[inline(always)]
+fn pair_forces<const DAMPED: bool>(
+    data: &PairForceData<'_, '_>,
+    dashpot: &Dashpot<'_>,
+    pair_force: &mut [[Vec3; LANES]],
+) -> V4 {
+    let rest = data.rest;
+    assert!(!DAMPED || rest.indexes_below(dashpot.v.len()));
     let mut fi = V4::default();
-    for (k, (o, eps)) in offset.iter().zip(residual.iter()).enumerate() {
+    let slots = data.offset.iter().zip(data.residual).zip(pair_force);
+    for (k, ((o, eps), out)) in slots.enumerate() {
         let c = rest.get(k);
-        let mut g = eps.scale_sub_from(c.w * c_scale, &m.mul(&c.d));
-        if damping > 0.0 {
+        let mut g = eps.scale_sub_from(c.w * data.c_scale, &data.m.mul(&c.d));
+        if DAMPED {
             // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
             let len2 = o.dot(o);
-            // SAFETY: checked before the loop (`damping > 0`).
-            let rate = (unsafe { rest.gather(input.v, k) } - vel_i).dot(o);
+            // SAFETY: checked before the loop.
+            let rate = (unsafe { rest.gather(dashpot.v, k) } - dashpot.vel_i).dot(o);
             let k2 = c.d.dot(&c.d);
             // Lanes of (nearly) coincident particles get no damping: their quotient (an
             // infinity or a NaN) is computed but not selected.
-            let s = (F4::splat(damping) * k2 * rate) / len2;
+            let s = (dashpot.damping * k2 * rate) / len2;
             let separated = F4::splat(1.0e-30).lt(len2);
             g = o.scale_add(separated.select(s, F4::splat(0.0)), &g);
         }
-        g.store(&mut pair_force[k]);
+        g.store(out);
         fi += g;
     }
-    fi.sum()
+    fi
 }
 
 #[cfg(test)]
