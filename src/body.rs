@@ -486,8 +486,8 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.state.x.len()];
         let mut rotation = vec![Quat::identity(); self.state.x.len()];
-        let mut pair_force = vec![Vec3::zeros(); self.model.nbr.slot_count()];
-        let mut own_force = vec![Vec3::zeros(); self.state.x.len()];
+        // One thread keeps no pair forces.
+        let (mut pair_force, mut own_force) = (Vec::new(), Vec::new());
         let zero = vec![Vec3::zeros(); self.state.x.len()];
         let input = ForceInputs {
             nbr: &self.model.nbr,

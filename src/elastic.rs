@@ -102,7 +102,8 @@ pub struct ForceInputs<'a> {
 /// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
 ///
 /// `rotation` holds each particle's rotation, warm-started and updated in place; `pair_force`
-/// (one entry per pair slot) and `own_force` (one per particle) are scratch: no allocation inside.
+/// (one entry per pair slot) and `own_force` (one per particle) are scratch, used on several
+/// threads only (they may be empty on one): no allocation inside.
 ///
 /// Every particle `i` computes its deformation gradient, rotation and stress and the force
 /// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). The particles are split into
@@ -149,8 +150,12 @@ fn accumulate_forces_in(
 ) {
     let nbr = pass.input.nbr;
     let n = nbr.particle_count();
-    assert!(rotation.len() == n && own_force.len() == n && force.len() == n);
-    assert_eq!(pair_force.len(), nbr.slot_count());
+    assert!(rotation.len() == n && force.len() == n);
+    let several = pool.threads() > 1;
+    assert!(
+        !several || (pair_force.len() == nbr.slot_count() && own_force.len() == n),
+        "the kept forces are sized for several threads"
+    );
     let rotation = SharedSlice::new(rotation);
     let pairs = SharedSlice::new(pair_force);
     let own = SharedSlice::new(own_force);
@@ -160,7 +165,14 @@ fn accumulate_forces_in(
         let _guard = barrier.guard();
         let particles = pool.share(share, n);
         {
-            let slots = nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize;
+            // One share keeps nothing (its kept forces may be empty).
+            let (slots, kept) = match several {
+                true => (
+                    nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize,
+                    particles.clone(),
+                ),
+                false => (0..0, 0..0),
+            };
             // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
             let mut out = unsafe {
                 ShareForces {
@@ -168,14 +180,14 @@ fn accumulate_forces_in(
                     share: particles.clone(),
                     force: forces.range(particles.clone()),
                     pair_force: pairs.range(slots),
-                    own: own.range(particles.clone()),
+                    own: own.range(kept),
                 }
             };
             // SAFETY: as above.
             let rotation = unsafe { rotation.range(particles.clone()) };
             kernel.share_pass(pass, rotation, &mut out);
         }
-        if pool.threads() == 1 {
+        if !several {
             return; // one share: no particle crosses shares
         }
         barrier.wait();

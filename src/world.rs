@@ -117,6 +117,8 @@ impl World {
         }
         if settings.threads != s.threads {
             self.pool = Pool::new(settings.threads as usize);
+            let models = self.bodies.iter().map(|b| &*b.model);
+            self.workspace.set_threads(models, self.pool.threads());
         }
         self.settings = settings;
         Ok(())
@@ -139,7 +141,7 @@ impl World {
     /// and its arrays are not copied. Cutting the body gives it its own copy of the model
     /// first; the other holders keep theirs.
     pub fn add_body_model(&mut self, model: Arc<BodyModel>) -> BodyId {
-        self.workspace.add_body(&model);
+        self.workspace.add_body(&model, self.pool.threads());
         self.bodies.push(Body::from_model(model, &self.settings));
         BodyId(self.bodies.len() as u32 - 1)
     }
@@ -668,5 +670,52 @@ mod tests {
                 .map_or(true, |r| r.1 >= crate::statics::SETTLE_SPEED),
             "{without:?}"
         );
+    }
+
+    /// The force pass keeps pair forces only on several threads: a world on one holds none (a
+    /// body's worth of memory, ~15 MB on liver_31k); switched to two it sizes them and steps
+    /// with the bits of a world built on two; switched back it frees them.
+    #[test]
+    fn kept_pair_forces_follow_the_thread_count() {
+        let world = |threads| {
+            let mut w = World::new(Settings {
+                threads,
+                ..Settings::default()
+            })
+            .unwrap();
+            let mesh = lattice_box(Vec3::zeros(), Vec3::new(0.08, 0.04, 0.04), [8, 4, 4]);
+            let id = w.add_body(&mesh, &crate::BodyOptions::default()).unwrap();
+            w.fix_box(id, Vec3::repeat(-1.0), Vec3::new(1e-6, 1.0, 1.0))
+                .unwrap();
+            w
+        };
+        let kept = |w: &World| {
+            let s = &w.workspace.bodies[0];
+            (s.pair_force.len(), s.own_force.len())
+        };
+        let sized = {
+            let b = &world(1).bodies[0];
+            (b.model.nbr.slot_count(), b.state.x.len())
+        };
+        let mut switched = world(1);
+        assert_eq!(kept(&switched), (0, 0));
+        switched
+            .set_settings(Settings {
+                threads: 2,
+                ..Settings::default()
+            })
+            .unwrap();
+        assert_eq!(kept(&switched), sized);
+        let mut built = world(2);
+        assert_eq!(kept(&built), sized);
+        for _ in 0..20 {
+            switched.step().unwrap();
+            built.step().unwrap();
+        }
+        assert_eq!(switched.bodies[0].state.x, built.bodies[0].state.x);
+        assert!(switched.bodies[0].state.v.iter().any(|v| v.norm() > 0.0));
+        switched.set_settings(Settings::default()).unwrap();
+        assert_eq!(kept(&switched), (0, 0));
+        switched.step().unwrap();
     }
 }

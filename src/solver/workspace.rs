@@ -16,10 +16,12 @@ pub(crate) struct StepScratch {
     pub(crate) p: Vec<Vec3>,
     /// Forces of the current substep (N).
     pub(crate) force: Vec<Vec3>,
-    /// Pair forces of the force pass (N), one entry per pair slot: on several threads, those
-    /// kept for the particles summed after its barrier (`crate::pair_sums`).
+    /// Pair forces of the force pass (N) kept for the particles summed after its barrier
+    /// (`crate::pair_sums`), one entry per pair slot; empty on one thread, where nothing is
+    /// kept.
     pub(crate) pair_force: Vec<Vec3>,
-    /// The particles' sums of their pair forces (N), kept as `pair_force` is.
+    /// The particles' sums of their pair forces (N), kept as `pair_force` is (one entry per
+    /// particle; empty on one thread).
     pub(crate) own_force: Vec<Vec3>,
     /// XPBD multipliers of the volume constraints within a substep, one per load-time
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones).
@@ -29,16 +31,34 @@ pub(crate) struct StepScratch {
 }
 
 impl StepScratch {
-    /// Scratch sized for a body on `model`.
-    pub(crate) fn for_model(model: &BodyModel) -> StepScratch {
+    /// Scratch sized for a body on `model` stepped on `threads` threads.
+    pub(crate) fn for_model(model: &BodyModel, threads: usize) -> StepScratch {
         let n = model.particle_count();
-        StepScratch {
+        let mut scratch = StepScratch {
             p: model.rest.clone(),
             force: vec![Vec3::zeros(); n],
-            pair_force: vec![Vec3::zeros(); model.nbr.slot_count()],
-            own_force: vec![Vec3::zeros(); n],
+            pair_force: Vec::new(),
+            own_force: Vec::new(),
             tet_lambda: vec![0.0; model.tets.len()],
             scan: ParticleScan::EMPTY,
+        };
+        scratch.size_kept(model, threads);
+        scratch
+    }
+
+    /// Size the force pass's kept forces for `threads` threads: a body's worth on several,
+    /// none on one (the memory is freed).
+    fn size_kept(&mut self, model: &BodyModel, threads: usize) {
+        let (slots, particles) = match threads {
+            1 => (0, 0),
+            _ => (model.nbr.slot_count(), model.particle_count()),
+        };
+        for (kept, len) in [
+            (&mut self.pair_force, slots),
+            (&mut self.own_force, particles),
+        ] {
+            kept.resize(len, Vec3::zeros());
+            kept.shrink_to_fit();
         }
     }
 }
@@ -57,10 +77,21 @@ pub(crate) struct Workspace {
 }
 
 impl Workspace {
-    /// Make room for one more body, on `model`.
-    pub(crate) fn add_body(&mut self, model: &BodyModel) {
-        self.bodies.push(StepScratch::for_model(model));
+    /// Make room for one more body, on `model`, stepped on `threads` threads.
+    pub(crate) fn add_body(&mut self, model: &BodyModel, threads: usize) {
+        self.bodies.push(StepScratch::for_model(model, threads));
         let particles = self.bodies.iter().map(|s| s.p.len()).sum();
         self.grid.reserve(particles);
+    }
+
+    /// Size every body's scratch (the bodies on `models`, in order) for `threads` threads.
+    pub(crate) fn set_threads<'a>(
+        &mut self,
+        models: impl Iterator<Item = &'a BodyModel>,
+        threads: usize,
+    ) {
+        for (scratch, model) in self.bodies.iter_mut().zip(models) {
+            scratch.size_kept(model, threads);
+        }
     }
 }
