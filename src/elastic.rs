@@ -166,12 +166,14 @@ fn accumulate_forces_in(
         let particles = pool.share(share, n);
         {
             // One share keeps nothing (its kept forces may be empty).
-            let (slots, kept) = match several {
-                true => (
-                    nbr.offsets[particles.start] as usize..nbr.offsets[particles.end] as usize,
+            let (slots, kept) = if several {
+                let first_slot = nbr.offsets[particles.start] as usize;
+                (
+                    first_slot..nbr.offsets[particles.end] as usize,
                     particles.clone(),
-                ),
-                false => (0..0, 0..0),
+                )
+            } else {
+                (0..0, 0..0)
             };
             // SAFETY: shares own disjoint particle ranges, hence disjoint pair ranges (CSR).
             let mut out = unsafe {
