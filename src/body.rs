@@ -294,6 +294,12 @@ pub struct Body {
     pub(crate) inv_mass: Vec<Real>,
     /// Fixed flags.
     pub(crate) fixed: Vec<bool>,
+    /// `active_before[i]`: how many of the particles before `i` are not inert (length:
+    /// particles + 1). An inert particle is fixed, and so is every one of its neighbours: its
+    /// elastic terms act only on fixed particles, whose forces a step does not use, so the
+    /// step's force pass skips it ([`ForceInputs::active_before`]). Follows the fixed flags
+    /// ([`Body::fixed_flags_changed`]).
+    pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::cut::CutState>>,
     /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
@@ -320,6 +326,7 @@ impl Body {
             inv_mass: vec![0.0; n],
             inertial_mass: model.mass.clone(),
             fixed: vec![false; n],
+            active_before: (0..=n as u32).collect(),
             cuts: None,
             omega_max: 0.0,
             volume_compliance: 0.0,
@@ -494,6 +501,7 @@ impl Body {
             volume: &self.model.particle_volume,
             x: positions,
             v: &zero,
+            active_before: &[],
         };
         elastic::accumulate_forces(
             &self.elastic,
@@ -591,11 +599,21 @@ impl Body {
         k
     }
 
-    /// Mark particle `i` fixed: zero inverse mass and velocity.
-    pub(crate) fn fix(&mut self, i: usize) {
-        self.fixed[i] = true;
-        self.inv_mass[i] = 0.0;
-        self.state.v[i] = Vec3::zeros();
+    /// Mark the `particles` fixed: zero velocity, and what follows from the fixed flags.
+    pub(crate) fn fix(&mut self, particles: impl IntoIterator<Item = usize>) {
+        for i in particles {
+            self.fixed[i] = true;
+            self.state.v[i] = Vec3::zeros();
+        }
+        self.fixed_flags_changed();
+    }
+
+    /// Recompute what follows from the fixed flags: the inverse masses and the inert particles.
+    /// A cut leaves the neighbour lists as they were (it zeroes a cut pair's data), so the
+    /// inert particles depend on the fixed flags alone.
+    pub(crate) fn fixed_flags_changed(&mut self) {
+        self.update_inverse_masses();
+        elastic::count_active(&self.model.nbr, &self.fixed, &mut self.active_before);
     }
 }
 

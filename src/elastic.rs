@@ -97,6 +97,13 @@ pub struct ForceInputs<'a> {
     pub x: &'a [Vec3],
     /// Current velocities (m/s); used only when the model's damping is non-zero.
     pub v: &'a [Vec3],
+    /// Which particles' terms are computed, or empty: all of them. Otherwise `active_before[i]`
+    /// counts the computed particles before `i` (length: particles + 1), and a particle that
+    /// is not counted must be one whose terms act on nothing that is used: a fixed particle
+    /// whose neighbours are all fixed (`Body::active_before`). The pass skips a block of four
+    /// such particles, which leaves the forces on fixed particles incomplete and their
+    /// rotations as they were, and splits the particles among the threads by the computed ones.
+    pub active_before: &'a [u32],
 }
 
 /// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
@@ -110,7 +117,8 @@ pub struct ForceInputs<'a> {
 /// one contiguous share per thread; each share runs its particles in order and scatters each
 /// term to a particle all of whose terms come from the share, and keeps the others for a sum
 /// after a barrier, in the same order ([`crate::pair_sums`]). Every force is so summed in the
-/// one-thread order: the result is bit-identical for any number of threads.
+/// one-thread order: the result is bit-identical for any number of threads. Particles that
+/// [`ForceInputs::active_before`] leaves out are skipped, four at a time.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_forces(
     model: &ElasticModel,
@@ -151,6 +159,8 @@ fn accumulate_forces_in(
     let nbr = pass.input.nbr;
     let n = nbr.particle_count();
     assert!(rotation.len() == n && force.len() == n);
+    let active_before = pass.input.active_before;
+    assert!(active_before.is_empty() || active_before.len() == n + 1);
     let several = pool.threads() > 1;
     assert!(
         !several || (pair_force.len() == nbr.slot_count() && own_force.len() == n),
@@ -163,7 +173,7 @@ fn accumulate_forces_in(
     let barrier = Barrier::new(pool.threads());
     pool.run(&|share| {
         let _guard = barrier.guard();
-        let particles = pool.share(share, n);
+        let particles = balanced_share(pool, share, active_before, n);
         {
             // One share keeps nothing (its kept forces may be empty).
             let (slots, kept) = if several {
@@ -207,6 +217,39 @@ fn accumulate_forces_in(
     });
 }
 
+/// Which particles a step's force pass computes, given the `fixed` flags: into
+/// `active_before[i]` (length: particles + 1), how many of the particles before `i` are not
+/// inert, an inert particle being fixed with every neighbour fixed ([`ForceInputs::active_before`]).
+pub(crate) fn count_active(nbr: &Neighbourhoods, fixed: &[bool], active_before: &mut [u32]) {
+    assert!(fixed.len() == nbr.particle_count() && active_before.len() == fixed.len() + 1);
+    let mut active = 0;
+    for (i, &fixed_i) in fixed.iter().enumerate() {
+        active_before[i] = active;
+        let inert = fixed_i && nbr.index[nbr.range(i)].iter().all(|&j| fixed[j as usize]);
+        active += u32::from(!inert);
+    }
+    active_before[fixed.len()] = active;
+}
+
+/// The particles of share `share` of the `n` in a force pass: contiguous ranges in order that
+/// hold as many computed particles each as [`Pool::share`] would give them (see
+/// [`ForceInputs::active_before`]).
+fn balanced_share(pool: &Pool, share: usize, active_before: &[u32], n: usize) -> Range<usize> {
+    if active_before.is_empty() {
+        return pool.share(share, n);
+    }
+    let computed = active_before[n] as usize;
+    let boundary = |k: usize| match k {
+        0 => 0,
+        k if k == pool.threads() => n,
+        k => {
+            let work = pool.share(k, computed).start;
+            active_before[..n].partition_point(|&a| (a as usize) < work)
+        }
+    };
+    boundary(share)..boundary(share + 1)
+}
+
 /// What every particle of a force pass needs besides its own arrays.
 struct ParticlePass<'a, 'b> {
     model: &'a ElasticModel,
@@ -227,6 +270,10 @@ fn share_pass(pass: &ParticlePass<'_, '_>, rotation: &mut [Quat], out: &mut Shar
         let first = share.start + block * LANES;
         let particles = first..first + q.len();
         let base = nbr.offsets[first] as usize;
+        let active = pass.input.active_before;
+        if !active.is_empty() && active[particles.start] == active[particles.end] {
+            continue; // a block of inert particles
+        }
         let own = &mut own[..q.len()];
         block_pair_forces(pass, first, q, &mut buffer, own);
         for (i, &fi) in particles.zip(own.iter()) {
@@ -690,6 +737,7 @@ mod tests {
             volume: &volume,
             x: &x,
             v: &v,
+            active_before: &[],
         };
         let f = forces(&model, &input, 1);
         // Three threads: shares of odd length (pass B takes particles two at a time).
@@ -712,6 +760,76 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The pass skips the blocks of inert particles (fixed, with every neighbour fixed) and
+    /// changes no force on a particle that is not fixed, on one thread or several (whose
+    /// shares it balances by the particles computed). Marking a fixed particle with a free
+    /// neighbour inert does change them: the skip is real.
+    #[test]
+    fn inert_particles_change_no_free_force() {
+        let rest = jittered_block();
+        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
+        let n = rest.len();
+        let volume = vec![1.0; n];
+        let damped = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
+        let x = deformed(&rest);
+        let v: Vec<Vec3> = x
+            .iter()
+            .map(|p| Vec3::new(0.1 * p.y, -0.2 * p.z, 0.05))
+            .collect();
+        // The block's first three layers (x ≤ 2 before the jitter) fixed.
+        let fixed: Vec<bool> = rest.iter().map(|p| p.x < 2.5).collect();
+        let mut active_before = vec![0; n + 1];
+        count_active(&nbr, &fixed, &mut active_before);
+        let inert = |i: usize| active_before[i] == active_before[i + 1];
+        let inert_blocks = (0..n / LANES)
+            .filter(|b| (b * LANES..(b + 1) * LANES).all(inert))
+            .count();
+        assert!(inert_blocks >= 2, "{inert_blocks} inert blocks");
+        assert!((0..n).all(|i| !inert(i) || fixed[i]));
+        let input = |active_before| ForceInputs {
+            nbr: &nbr,
+            volume: &volume,
+            x: &x,
+            v: &v,
+            active_before,
+        };
+        let free_forces = |f: Vec<Vec3>| -> Vec<Vec3> {
+            f.into_iter()
+                .zip(&fixed)
+                .filter(|(_, &fixed)| !fixed)
+                .map(|(f, _)| f)
+                .collect()
+        };
+        let all = free_forces(forces(&damped, &input(&[]), 1));
+        for threads in 1..=3 {
+            let pool = Pool::new(threads);
+            let shares: Vec<_> = (0..threads)
+                .map(|k| balanced_share(&pool, k, &active_before, n))
+                .collect();
+            assert_eq!((shares[0].start, shares[threads - 1].end), (0, n));
+            for (k, pair) in shares.windows(2).enumerate() {
+                assert_eq!(pair[0].end, pair[1].start, "share {k}");
+            }
+            for (k, share) in shares.iter().enumerate() {
+                let computed = active_before[share.end] - active_before[share.start];
+                let even = pool.share(k, active_before[n] as usize).len() as u32;
+                assert_eq!(computed, even, "share {k}");
+            }
+            let skipped = forces(&damped, &input(&active_before), threads);
+            assert_eq!(all, free_forces(skipped), "{threads} threads");
+        }
+        // A fixed particle next to a free one, wrongly marked inert with its block.
+        let edge = (0..n)
+            .find(|&i| fixed[i] && nbr.index[nbr.range(i)].iter().any(|&j| !fixed[j as usize]))
+            .unwrap();
+        let block = edge / LANES * LANES;
+        let mut wrong = active_before.clone();
+        for (i, w) in wrong.iter_mut().enumerate().skip(block + 1) {
+            *w = active_before[i] - (active_before[i.min(block + LANES)] - active_before[block]);
+        }
+        assert_ne!(all, free_forces(forces(&damped, &input(&wrong), 1)));
     }
 
     /// The gathers of the pair loops read without a check per index, after one check per
@@ -737,6 +855,7 @@ mod tests {
                 volume: &volume,
                 x,
                 v,
+                active_before: &[],
             };
             let pass = ParticlePass {
                 model: &damped,
@@ -783,6 +902,7 @@ mod tests {
             volume: &volume,
             x: &x,
             v: &v,
+            active_before: &[],
         };
         let pass = ParticlePass {
             model: &model,
@@ -837,6 +957,7 @@ mod tests {
                 volume: &volume,
                 x: &rest,
                 v,
+                active_before: &[],
             };
             forces(&damped, &input, 1)
         };

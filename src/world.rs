@@ -246,9 +246,7 @@ impl World {
                 "particle index {k} out of range (body has {n} particles)"
             )));
         }
-        for &k in indices {
-            body.fix(k as usize);
-        }
+        body.fix(indices.iter().map(|&k| k as usize));
         Ok(())
     }
     /// Fix every particle whose current position lies in the box `[min, max]` (m, world
@@ -270,9 +268,7 @@ impl World {
                 (0..3).all(|a| p[a] >= min[a] && p[a] <= max[a])
             })
             .collect();
-        for &i in &inside {
-            body.fix(i);
-        }
+        body.fix(inside.iter().copied());
         Ok(inside.len())
     }
     /// Add a kinematic tool. Its surface samples (for the sampled contact mode) are spaced by

@@ -256,7 +256,7 @@ impl World {
             crate::cut::restore(body, &s.cuts);
             if body.fixed != s.fixed {
                 body.fixed.copy_from_slice(&s.fixed);
-                body.update_inverse_masses();
+                body.fixed_flags_changed();
             }
             body.state.assign(&s.particles);
         }

@@ -117,6 +117,41 @@ fn the_fixed_flags_are_part_of_the_state() {
     assert_ne!(w.body(b).unwrap().positions()[freed], x0);
 }
 
+/// A block with its bottom half fixed has inert particles (fixed, every neighbour fixed),
+/// whose terms the force pass skips. A state that frees them makes them count again: after
+/// it, the world steps with the bits of one that never fixed them.
+#[test]
+fn a_state_that_frees_inert_particles_computes_them_again() {
+    let block = || {
+        let mut w = World::new(Settings::default()).unwrap();
+        let lo = Vec3::new(-SIDE / 2.0, 0.0, -SIDE / 2.0);
+        let hi = Vec3::new(SIDE / 2.0, SIDE, SIDE / 2.0);
+        let b = w
+            .add_body(&lattice_box(lo, hi, [6, 6, 6]), &BodyOptions::default())
+            .unwrap();
+        w.fix_box(b, Vec3::repeat(-1.0), Vec3::new(1.0, 1e-6, 1.0))
+            .unwrap();
+        (w, b)
+    };
+    let run = |w: &mut World, b: BodyId| {
+        for _ in 0..20 {
+            w.step().unwrap();
+        }
+        w.body(b).unwrap().positions().to_vec()
+    };
+    let (mut never, b) = block();
+    let expected = run(&mut never, b);
+    let (mut w, b) = block();
+    let base_only = w.state();
+    let half = w
+        .fix_box(b, Vec3::repeat(-1.0), Vec3::new(1.0, SIDE / 2.0, 1.0))
+        .unwrap();
+    assert!(half > 100, "{half} fixed");
+    run(&mut w, b);
+    w.set_state(&base_only).unwrap();
+    assert_eq!(run(&mut w, b), expected);
+}
+
 /// A step that diverges puts the whole state back: the needle's holds and the grasp as well as
 /// the particles. The same step without the divergence changes the needle's holds, so the
 /// comparison has something to catch.

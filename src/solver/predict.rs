@@ -42,6 +42,7 @@ pub(crate) fn predict(
         volume: &body.model.particle_volume,
         x: &body.state.x,
         v: &body.state.v,
+        active_before: &body.active_before,
     };
     accumulate_forces(
         &body.elastic,
