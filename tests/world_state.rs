@@ -21,8 +21,8 @@ fn scene(depth: Real) -> (World, BodyId, ToolId) {
     scene_on(depth, 1)
 }
 
-/// [`scene`] on `threads` threads.
-fn scene_on(depth: Real, threads: u32) -> (World, BodyId, ToolId) {
+/// The block alone on its fixed base, on `threads` threads.
+fn block_on(threads: u32) -> (World, BodyId) {
     let settings = Settings {
         threads,
         ..Settings::default()
@@ -35,6 +35,12 @@ fn scene_on(depth: Real, threads: u32) -> (World, BodyId, ToolId) {
         .unwrap();
     w.fix_box(b, Vec3::repeat(-1.0), Vec3::new(1.0, 1e-6, 1.0))
         .unwrap();
+    (w, b)
+}
+
+/// [`scene`] on `threads` threads.
+fn scene_on(depth: Real, threads: u32) -> (World, BodyId, ToolId) {
+    let (mut w, b) = block_on(threads);
     let shaft = ToolShape::Capsule {
         half_height: HALF,
         radius: RADIUS,
@@ -122,26 +128,15 @@ fn the_fixed_flags_are_part_of_the_state() {
 /// it, the world steps with the bits of one that never fixed them.
 #[test]
 fn a_state_that_frees_inert_particles_computes_them_again() {
-    let block = || {
-        let mut w = World::new(Settings::default()).unwrap();
-        let lo = Vec3::new(-SIDE / 2.0, 0.0, -SIDE / 2.0);
-        let hi = Vec3::new(SIDE / 2.0, SIDE, SIDE / 2.0);
-        let b = w
-            .add_body(&lattice_box(lo, hi, [6, 6, 6]), &BodyOptions::default())
-            .unwrap();
-        w.fix_box(b, Vec3::repeat(-1.0), Vec3::new(1.0, 1e-6, 1.0))
-            .unwrap();
-        (w, b)
-    };
     let run = |w: &mut World, b: BodyId| {
         for _ in 0..20 {
             w.step().unwrap();
         }
         w.body(b).unwrap().positions().to_vec()
     };
-    let (mut never, b) = block();
+    let (mut never, b) = block_on(1);
     let expected = run(&mut never, b);
-    let (mut w, b) = block();
+    let (mut w, b) = block_on(1);
     let base_only = w.state();
     let half = w
         .fix_box(b, Vec3::repeat(-1.0), Vec3::new(1.0, SIDE / 2.0, 1.0))
