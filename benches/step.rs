@@ -4,7 +4,9 @@
 //! ```text
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k] [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
+//!                             [--times PATH]
 //! ```
+//! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
 //! - `haptic` (DESIGN §7): mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
 //!   dt = 1 ms, top 10% of the y range fixed, gravity;
@@ -55,6 +57,8 @@ struct Row {
     mean: f64,
     bytes: usize,
     contacts: u32,
+    /// Every timed step's time (ms), in step order.
+    series: Vec<f64>,
 }
 
 fn percentile(sorted: &[f64], q: f64) -> f64 {
@@ -195,6 +199,7 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row
         }
     }
     let mean = times.iter().sum::<f64>() / times.len() as f64;
+    let series = times.clone();
     times.sort_by(|a, b| a.total_cmp(b));
     let b = world.body(body).unwrap();
     Row {
@@ -209,6 +214,7 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row
         mean,
         bytes,
         contacts,
+        series,
     }
 }
 
@@ -221,6 +227,7 @@ fn main() {
     ];
     let mut steps = 2000;
     let mut csv: Option<PathBuf> = None;
+    let mut times_csv: Option<PathBuf> = None;
     let mut scene_name = "haptic".to_string();
     let mut threads = 1;
     let mut args = std::env::args().skip(1);
@@ -236,6 +243,7 @@ fn main() {
             }
             "--steps" => steps = args.next().expect("--steps N").parse().expect("a number"),
             "--csv" => csv = Some(PathBuf::from(args.next().expect("--csv PATH"))),
+            "--times" => times_csv = Some(PathBuf::from(args.next().expect("--times PATH"))),
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
             "--bench" => {}
@@ -260,6 +268,7 @@ fn main() {
     let mut out = String::from(
         "scene,threads,mesh,probe,particles,pairs,substeps,median_ms,p99_ms,max_ms,mean_ms,us_per_1000_particles,bytes_per_particle,contacts\n",
     );
+    let mut series = String::from("scene,threads,mesh,probe,step,ms\n");
     for m in &meshes {
         for probe in [false, true] {
             let r = run(m, scene(&scene_name), probe, steps, threads);
@@ -286,9 +295,17 @@ fn main() {
                 bpp,
                 r.contacts
             );
+            for (k, ms) in r.series.iter().enumerate() {
+                series += &format!(
+                    "{scene_name},{threads},{},{},{k},{ms:.4}\n",
+                    r.mesh, r.probe
+                );
+            }
         }
     }
-    if let Some(path) = csv {
-        std::fs::write(&path, out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    for (path, text) in [(csv, out), (times_csv, series)] {
+        if let Some(path) = path {
+            std::fs::write(&path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        }
     }
 }

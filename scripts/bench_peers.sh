@@ -10,7 +10,8 @@
 # OMP_NUM_THREADS=1 and =2. tissuesim runs the same scene with Settings::threads 1 and 2 (cargo
 # bench --bench step -- --scene pypbd --threads N). The peer prints a mean over its steps, so the
 # ratios are of means (1 thread vs 1 thread, 2 vs 2); tissuesim's median and p99 are given beside
-# them. Writes docs/data/peers.csv and docs/data/bench_haptic.csv. Run it on an idle machine.
+# them. Writes docs/data/peers.csv, docs/data/bench_haptic.csv and docs/data/step_times_haptic.txt
+# (the haptic scene's step-time distribution). Run it on an idle machine.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -49,6 +50,10 @@ done
 
 echo
 echo "DESIGN §7 haptic scene (SI, dt = 1 ms), 1 and 2 threads:"
-cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads 1 --csv "$TMP/h1.csv"
-cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads 2 --csv "$TMP/h2.csv"
+for t in 1 2; do
+  cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads "$t" --csv "$TMP/h$t.csv" --times "$TMP/times$t.csv"
+done
 { cat "$TMP/h1.csv"; tail -n +2 "$TMP/h2.csv"; } > "$OUT/bench_haptic.csv"
+echo
+echo "Haptic scene, the distribution of the step times (scripts/step_times.py):"
+python3 scripts/step_times.py "$TMP/times1.csv" "$TMP/times2.csv" | tee "$OUT/step_times_haptic.txt"
