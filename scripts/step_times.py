@@ -10,12 +10,14 @@ isolated interruptions.
 """
 
 import csv
+import math
 import sys
 
 
 def percentile(sorted_ms, q):
-    """The same nearest-rank percentile as benches/step.rs."""
-    return sorted_ms[round((len(sorted_ms) - 1) * q)]
+    """The same nearest-rank percentile as benches/step.rs (halves rounded up, as Rust's
+    `round` does for positive numbers; Python's `round` would take the even neighbour)."""
+    return sorted_ms[math.floor((len(sorted_ms) - 1) * q + 0.5)]
 
 
 def summarise(ms):
