@@ -263,17 +263,17 @@ struct ParticlePass<'a, 'b> {
 #[inline(always)]
 fn share_pass(pass: &ParticlePass<'_, '_>, rotation: &mut [Quat], out: &mut ShareForces<'_>) {
     let nbr = pass.input.nbr;
+    let active = pass.input.active_before;
     let share = out.share.clone();
     let mut buffer = BlockBuffer::new();
     let mut own = [Vec3::zeros(); LANES];
     for (block, q) in rotation.chunks_mut(LANES).enumerate() {
         let first = share.start + block * LANES;
         let particles = first..first + q.len();
-        let base = nbr.offsets[first] as usize;
-        let active = pass.input.active_before;
         if !active.is_empty() && active[particles.start] == active[particles.end] {
             continue; // a block of inert particles
         }
+        let base = nbr.offsets[first] as usize;
         let own = &mut own[..q.len()];
         block_pair_forces(pass, first, q, &mut buffer, own);
         for (i, &fi) in particles.zip(own.iter()) {
