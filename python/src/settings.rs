@@ -1,0 +1,238 @@
+//! `Settings`, `DivergenceLimits` and `ContactMode`: the world's parameters, every field as in
+//! the Rust `tissuesim::Settings` (SI units; see the `.pyi` stub for each field's unit).
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tissuesim::{Real, Vec3};
+
+/// How tool–tissue contact is detected.
+#[pyclass(module = "tissuesim", eq, eq_int, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum ContactMode {
+    /// The tool's exact shape against the body's deformed boundary triangles (the default).
+    ExactShape,
+    /// The paper's mode: the tool surface sampled into points pushing particles out.
+    SampledPoints,
+}
+
+impl From<ContactMode> for tissuesim::ContactMode {
+    fn from(m: ContactMode) -> Self {
+        match m {
+            ContactMode::ExactShape => tissuesim::ContactMode::ExactShape,
+            ContactMode::SampledPoints => tissuesim::ContactMode::SampledPoints,
+        }
+    }
+}
+
+impl From<tissuesim::ContactMode> for ContactMode {
+    fn from(m: tissuesim::ContactMode) -> Self {
+        match m {
+            tissuesim::ContactMode::ExactShape => ContactMode::ExactShape,
+            tissuesim::ContactMode::SampledPoints => ContactMode::SampledPoints,
+        }
+    }
+}
+
+/// Bounds beyond which a step counts as diverged and is rolled back (relative to the body's
+/// rest size; infinity switches a check off).
+#[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
+#[derive(Clone, PartialEq, Debug)]
+pub struct DivergenceLimits {
+    /// Largest particle speed, in body sizes per second (1/s).
+    pub max_speed: Real,
+    /// Largest deformed extent over the rest size (dimensionless).
+    pub max_extent_ratio: Real,
+    /// Accepted range of volume / rest volume (dimensionless).
+    pub volume_ratio: (Real, Real),
+}
+
+impl From<&DivergenceLimits> for tissuesim::DivergenceLimits {
+    fn from(d: &DivergenceLimits) -> Self {
+        tissuesim::DivergenceLimits {
+            max_speed: d.max_speed,
+            max_extent_ratio: d.max_extent_ratio,
+            volume_ratio: d.volume_ratio,
+        }
+    }
+}
+
+impl From<&tissuesim::DivergenceLimits> for DivergenceLimits {
+    fn from(d: &tissuesim::DivergenceLimits) -> Self {
+        DivergenceLimits {
+            max_speed: d.max_speed,
+            max_extent_ratio: d.max_extent_ratio,
+            volume_ratio: d.volume_ratio,
+        }
+    }
+}
+
+#[pymethods]
+impl DivergenceLimits {
+    /// The defaults (250 body sizes/s, extent ratio 10, volume ratio in [0.1, 10]), with any
+    /// field given by keyword.
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut s = DivergenceLimits::from(&tissuesim::DivergenceLimits::default());
+        apply_kwargs!(s, kwargs, [max_speed, max_extent_ratio, volume_ratio]);
+        Ok(s)
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let s = self;
+        repr_fields!(
+            py,
+            "DivergenceLimits",
+            s,
+            [max_speed, max_extent_ratio, volume_ratio]
+        )
+    }
+}
+
+/// Parameters of the time integration and the constraint projection (see the stub for units).
+#[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
+#[derive(Clone, PartialEq, Debug)]
+pub struct Settings {
+    pub dt: Real,
+    pub gravity: [Real; 3],
+    pub min_substeps: u32,
+    pub max_substeps: u32,
+    pub stability_margin: Real,
+    pub mass_scaling: bool,
+    pub damping_mass: Real,
+    pub damping_stiffness: Real,
+    pub hourglass_stiffness: Real,
+    pub volume_constraints: bool,
+    pub volumetric_split: bool,
+    pub volume_compliance: Real,
+    pub iterations: u32,
+    pub contact_mode: ContactMode,
+    pub max_depenetration_speed: Real,
+    pub self_contact: bool,
+    pub threads: u32,
+    pub divergence: DivergenceLimits,
+}
+
+impl Settings {
+    /// The Rust settings.
+    pub(crate) fn to_core(&self) -> tissuesim::Settings {
+        let g = self.gravity;
+        tissuesim::Settings {
+            dt: self.dt,
+            gravity: Vec3::new(g[0], g[1], g[2]),
+            min_substeps: self.min_substeps,
+            max_substeps: self.max_substeps,
+            stability_margin: self.stability_margin,
+            mass_scaling: self.mass_scaling,
+            damping_mass: self.damping_mass,
+            damping_stiffness: self.damping_stiffness,
+            hourglass_stiffness: self.hourglass_stiffness,
+            volume_constraints: self.volume_constraints,
+            volumetric_split: self.volumetric_split,
+            volume_compliance: self.volume_compliance,
+            iterations: self.iterations,
+            contact_mode: self.contact_mode.into(),
+            max_depenetration_speed: self.max_depenetration_speed,
+            self_contact: self.self_contact,
+            threads: self.threads,
+            divergence: (&self.divergence).into(),
+        }
+    }
+    /// The Python settings of Rust settings.
+    pub(crate) fn from_core(s: &tissuesim::Settings) -> Self {
+        Settings {
+            dt: s.dt,
+            gravity: [s.gravity.x, s.gravity.y, s.gravity.z],
+            min_substeps: s.min_substeps,
+            max_substeps: s.max_substeps,
+            stability_margin: s.stability_margin,
+            mass_scaling: s.mass_scaling,
+            damping_mass: s.damping_mass,
+            damping_stiffness: s.damping_stiffness,
+            hourglass_stiffness: s.hourglass_stiffness,
+            volume_constraints: s.volume_constraints,
+            volumetric_split: s.volumetric_split,
+            volume_compliance: s.volume_compliance,
+            iterations: s.iterations,
+            contact_mode: s.contact_mode.into(),
+            max_depenetration_speed: s.max_depenetration_speed,
+            self_contact: s.self_contact,
+            threads: s.threads,
+            divergence: (&s.divergence).into(),
+        }
+    }
+}
+
+#[pymethods]
+impl Settings {
+    /// The defaults (`tissuesim::Settings::default()`: dt 1 ms, gravity -9.81 m/s² along y,
+    /// ...), with any field given by keyword.
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut s = Settings::from_core(&tissuesim::Settings::default());
+        apply_kwargs!(
+            s,
+            kwargs,
+            [
+                dt,
+                gravity,
+                min_substeps,
+                max_substeps,
+                stability_margin,
+                mass_scaling,
+                damping_mass,
+                damping_stiffness,
+                hourglass_stiffness,
+                volume_constraints,
+                volumetric_split,
+                volume_compliance,
+                iterations,
+                contact_mode,
+                max_depenetration_speed,
+                self_contact,
+                threads,
+                divergence,
+            ]
+        );
+        Ok(s)
+    }
+    /// Check every field (`ValueError` naming the first bad one).
+    fn validate(&self) -> PyResult<()> {
+        crate::errors::Check::py(self.to_core().validate())
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let s = self;
+        repr_fields!(
+            py,
+            "Settings",
+            s,
+            [
+                dt,
+                gravity,
+                min_substeps,
+                max_substeps,
+                stability_margin,
+                mass_scaling,
+                damping_mass,
+                damping_stiffness,
+                hourglass_stiffness,
+                volume_constraints,
+                volumetric_split,
+                volume_compliance,
+                iterations,
+                contact_mode,
+                max_depenetration_speed,
+                self_contact,
+                threads,
+                divergence,
+            ]
+        )
+    }
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ContactMode>()?;
+    m.add_class::<DivergenceLimits>()?;
+    m.add_class::<Settings>()?;
+    Ok(())
+}
