@@ -92,6 +92,14 @@ pub(crate) fn index_list(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32
 
 /// A point: any sequence of 3 reals.
 pub(crate) fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec3> {
+    // Fast path: a float64 array of 3 (the haptic loop's poses), read without Python calls.
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if let Ok(ro) = a.try_readonly() {
+            if let Ok([x, y, z]) = ro.as_slice() {
+                return Ok(Vec3::new(*x, *y, *z));
+            }
+        }
+    }
     let v: Vec<Real> = obj
         .extract()
         .map_err(|_| PyValueError::new_err(format!("{what} must be 3 numbers")))?;

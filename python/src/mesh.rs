@@ -101,11 +101,15 @@ impl TetMesh {
 }
 
 /// What cleaning a raw mesh changed.
-#[pyclass(module = "tissuesim.mesh", get_all, frozen)]
+#[pyclass(module = "tissuesim.mesh", frozen)]
 pub struct MeshReport {
+    #[pyo3(get)]
     pub reoriented_tets: usize,
+    #[pyo3(get)]
     pub degenerate_tets_removed: usize,
+    #[pyo3(get)]
     pub unreferenced_nodes_removed: usize,
+    #[pyo3(get)]
     pub skipped_elements: usize,
     original: Vec<u32>,
 }

@@ -1,0 +1,293 @@
+"""The API contract: node order, arrays, every tool shape, settings, render surfaces, errors
+(the right exception, the core's message, the world unchanged)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import MESHES
+
+import tissuesim as ts
+
+
+def small_block(world: ts.World) -> ts.BodyId:
+    return world.add_body(ts.mesh.lattice_box([0, 0, 0], [0.04, 0.02, 0.02], [4, 2, 2]))
+
+
+def test_body_arrays_are_in_the_files_node_order():
+    path = MESHES / "liver_4k.node"
+    rows = np.loadtxt(path, skiprows=1, comments="#")
+    file_nodes = rows[:, 1:4] * 0.03
+    ele = np.loadtxt(MESHES / "liver_4k.ele", skiprows=1, comments="#", dtype=np.int64)
+    mesh, report = ts.mesh.load(path, 0.03)
+    np.testing.assert_array_equal(report.original_node_index, np.arange(len(rows)))
+    np.testing.assert_array_equal(mesh.nodes, file_nodes)
+    world = ts.World()
+    body = world.body(world.add_body(mesh))
+    assert body.particle_count() == len(rows)
+    # Rest positions, positions and tetrahedra come back in the file's order, not the
+    # solver's internal (Morton) order.
+    assert not np.array_equal(body.particle_order(), np.arange(len(rows)))
+    np.testing.assert_array_equal(body.rest_positions(), file_nodes)
+    np.testing.assert_array_equal(body.positions(), file_nodes)
+    tets = body.tets()
+    assert tets.dtype == np.uint32 and tets.shape == (len(ele), 4)
+    np.testing.assert_array_equal(np.sort(tets, axis=1), np.sort(ele[:, 1:5], axis=1))
+
+
+def test_state_and_fixing_round_trip_in_node_order():
+    world = ts.World(ts.Settings(gravity=[0.0, 0.0, 0.0]))
+    b = small_block(world)
+    body = world.body(b)
+    n = body.particle_count()
+    rng = np.random.default_rng(1)
+    x = body.rest_positions() + rng.normal(scale=1e-4, size=(n, 3))
+    v = rng.normal(scale=1e-3, size=(n, 3))
+    world.set_body_state(b, x, v)
+    np.testing.assert_array_equal(body.positions(), x)
+    np.testing.assert_array_equal(body.velocities(), v)
+    world.fix_particles(b, [0, 7])
+    flags = body.fixed_flags()
+    assert flags.tolist() == [k in (0, 7) for k in range(n)]
+    assert body.is_fixed(7) and not body.is_fixed(1)
+    # Node 0 is (0, 0, 0) of the lattice; it stays there.
+    for _ in range(20):
+        world.step()
+    np.testing.assert_array_equal(body.positions()[[0, 7]], x[[0, 7]])
+    # fix_box counts the nodes inside.
+    assert world.fix_box(b, [-1, -1, -1], [0.005, 1, 1]) == 9
+
+
+def test_meshes_from_arrays_are_cleaned_and_reported():
+    nodes = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [9, 9, 9], [1, 1, 1]]
+    tets = [[0, 2, 1, 3], [1, 2, 3, 5]]  # the first inverted; node 4 unreferenced
+    mesh, report = ts.mesh.TetMesh.from_raw(np.array(nodes) * 0.01, tets)
+    assert report.reoriented_tets == 1
+    assert report.unreferenced_nodes_removed == 1
+    assert report.original_node_index.tolist() == [0, 1, 2, 3, 5]
+    assert mesh.node_count() == 5 and mesh.tet_count() == 2
+    assert mesh.volume() > 0
+    # A lattice with an extra node at index 3 that no tetrahedron uses: the body's rows are
+    # the cleaned mesh's, which the report maps back to the arrays given.
+    lattice = ts.mesh.lattice_box([0, 0, 0], [0.04, 0.02, 0.02], [4, 2, 2])
+    raw_nodes = np.insert(lattice.nodes, 3, [1.0, 1.0, 1.0], axis=0)
+    raw_tets = lattice.tets.astype(np.int64)
+    raw_tets[raw_tets >= 3] += 1
+    mesh, report = ts.mesh.TetMesh.from_raw(raw_nodes, raw_tets)
+    assert report.unreferenced_nodes_removed == 1
+    kept = report.original_node_index
+    assert 3 not in kept.tolist() and len(kept) == lattice.node_count()
+    world = ts.World()
+    body = world.body(world.add_body(mesh))
+    np.testing.assert_array_equal(body.rest_positions(), raw_nodes[kept])
+
+
+def test_the_default_organ_is_the_documented_one():
+    organ = ts.mesh.default_organ()
+    assert (organ.node_count(), organ.tet_count()) == (2243, 9918)
+    lo, hi = organ.bounding_box()
+    assert 0.2 < np.linalg.norm(hi - lo) < 0.3
+    assert organ.nodes.dtype == np.float64 and organ.nodes.shape == (2243, 3)
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [
+        ts.ToolShape.Sphere(0.01),
+        ts.ToolShape.Capsule(0.02, 0.005),
+        ts.ToolShape.Cylinder(0.02, 0.005),
+        ts.ToolShape.Cuboid([0.01, 0.02, 0.005]),
+        ts.ToolShape.ConvexHull([[0, 0, 0], [0.01, 0, 0], [0, 0.01, 0], [0, 0, 0.01]]),
+        ts.ToolShape.TriMesh(
+            [[0, 0, 0], [0.02, 0, 0], [0, 0.02, 0], [0, 0, 0.02]],
+            [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        ),
+        ts.ToolShape.from_obj(MESHES / "liver-smooth.obj", 0.003),
+    ],
+    ids=lambda s: s.kind,
+)
+def test_every_tool_shape_presses_the_tissue(shape):
+    world = ts.World(ts.Settings(gravity=[0.0, 0.0, 0.0]))
+    b = world.add_body(ts.mesh.lattice_box([-0.03, -0.03, -0.03], [0.03, 0, 0.03], [6, 3, 6]))
+    world.fix_box(b, [-1, -1, -1], [1, -0.029, 1])
+    lo = shape_bottom(shape)
+    start = ts.Pose([0.0, 0.003 - lo, 0.0], (1.0, 0.0, 0.0, 0.0))
+    tool = world.add_tool(shape, start, ts.ToolOptions(friction_static=0.3, friction_kinetic=0.2))
+    assert world.tool(tool).shape().kind == shape.kind
+    for k in range(300):
+        world.set_tool_pose(tool, start.position - [0.0, 0.008 * min(1.0, k / 150), 0.0])
+        world.step()
+    w = world.tool(tool).wrench()
+    assert w.force[1] > 0.0 and w.contact_count > 0, w
+    np.testing.assert_allclose(world.tool(tool).pose().position, start.position - [0, 0.008, 0])
+    assert world.tool(tool).options().friction_static == 0.3
+
+
+def shape_bottom(shape: ts.ToolShape) -> float:
+    """Lowest local y of a shape (m)."""
+    p = shape.parameters()
+    if shape.kind == "Sphere":
+        return -p["radius"]
+    if shape.kind == "Capsule":
+        return -p["half_height"] - p["radius"]
+    if shape.kind == "Cylinder":
+        return -p["half_height"]
+    if shape.kind == "Cuboid":
+        return -p["half_extents"][1]
+    pts = p.get("points", p.get("vertices"))
+    return float(np.min(pts[:, 1]))
+
+
+def test_settings_mirror_every_rust_field():
+    fields = [
+        "dt", "gravity", "min_substeps", "max_substeps", "stability_margin", "mass_scaling",
+        "damping_mass", "damping_stiffness", "hourglass_stiffness", "volume_constraints",
+        "volumetric_split", "volume_compliance", "iterations", "contact_mode",
+        "max_depenetration_speed", "self_contact", "threads", "divergence",
+    ]  # fmt: skip
+    s = ts.Settings()
+    for f in fields:
+        assert f"{f}=" in repr(s)
+    assert s.dt == 1e-3 and s.gravity == [0.0, -9.81, 0.0]
+    assert s.contact_mode == ts.ContactMode.ExactShape
+    custom = ts.Settings(
+        dt=5e-4,
+        threads=2,
+        contact_mode=ts.ContactMode.SampledPoints,
+        divergence=ts.DivergenceLimits(max_speed=100.0),
+    )
+    world = ts.World(custom)
+    assert world.settings() == custom
+    assert world.settings().divergence.max_speed == 100.0
+    custom.iterations = 3
+    world.set_settings(custom)
+    assert world.settings().iterations == 3
+    with pytest.raises(TypeError, match="unexpected keyword argument `dtt`"):
+        ts.Settings(dtt=1.0)
+
+
+def test_render_surfaces_follow_the_body(tmp_path):
+    world = ts.World()
+    b = small_block(world)
+    body = world.body(b)
+    rm = ts.render.RenderMesh.from_boundary(body.rest_positions(), body.boundary_triangles())
+    sid = world.add_render_surface(b, rm)
+    surface = world.render_surface(sid)
+    assert surface.body() == b
+    assert surface.bind_report().outside == 0
+    for _ in range(100):
+        world.step()
+    surface = world.update_render_surface(sid)
+    # A boundary surface's vertices are the boundary nodes, in order of first appearance in
+    # the triangles: they move exactly with them.
+    flat = body.boundary_triangles().ravel()
+    _, first = np.unique(flat, return_index=True)
+    nodes = flat[np.sort(first)]
+    np.testing.assert_allclose(surface.positions(), body.positions()[nodes], atol=1e-12)
+    normals = surface.normals()
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-9)
+    surface.write_obj(tmp_path / "s.obj")
+    surface.write_vtu(tmp_path / "s.vtu")
+    back = ts.render.read_obj(tmp_path / "s.obj")
+    np.testing.assert_array_equal(back.positions, surface.positions())
+    np.testing.assert_array_equal(back.triangles, surface.triangles())
+
+
+def test_a_shared_model_builds_the_same_body():
+    world = ts.World()
+    b = small_block(world)
+    model = world.body(b).load_time_model()
+    other = ts.World()
+    c = other.add_body_model(model)
+    np.testing.assert_array_equal(
+        other.body(c).rest_positions(), world.body(b).rest_positions()
+    )
+    built = ts.BodyModel(ts.mesh.lattice_box([0, 0, 0], [0.04, 0.02, 0.02], [4, 2, 2]))
+    assert built.particle_count() == model.particle_count()
+
+
+# --- errors ---------------------------------------------------------------------------------
+
+
+def test_a_missing_mesh_file_is_an_oserror_naming_it():
+    with pytest.raises(OSError, match="no_such_liver.msh") as e:
+        ts.mesh.load("/nonexistent/no_such_liver.msh")
+    assert isinstance(e.value, ts.MeshError)
+
+
+def test_a_malformed_mesh_names_the_file_and_line(tmp_path):
+    bad = tmp_path / "bad.node"
+    bad.write_text("5 3 0 0\n0 0 0 0\n1 1 0 zero\n")
+    (tmp_path / "bad.ele").write_text("1 4 0\n0 0 1 2 3\n")
+    with pytest.raises(ts.MeshError, match=r"bad.node:3"):
+        ts.mesh.load(bad)
+
+
+def test_bad_arrays_raise_valueerror_with_the_cores_message():
+    with pytest.raises(ValueError, match="<arrays>: tetrahedron 0 references node 9"):
+        ts.mesh.TetMesh.from_raw([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0, 1, 2, 9]])
+    with pytest.raises(ValueError, match=r"shape \(n, 3\)"):
+        ts.mesh.TetMesh([[0, 0], [1, 0]], [[0, 1, 2, 3]])
+    with pytest.raises(ValueError, match="integers"):
+        ts.mesh.TetMesh([[0, 0, 0]], [[0.5, 1, 2, 3]])
+
+
+def test_invalid_input_raises_and_leaves_the_world_as_it_was():
+    world = ts.World()
+    b = small_block(world)
+    tool = world.add_tool(ts.ToolShape.Sphere(0.005), [0.02, 0.05, 0.01])
+    for _ in range(5):
+        world.step()
+    saved = world.save_state()
+
+    with pytest.raises(ValueError, match=r"material\.poisson_ratio must be in \[0, 0\.49\]"):
+        world.add_body(
+            ts.mesh.default_organ(),
+            ts.BodyOptions(material=ts.Material(poisson_ratio=0.6)),
+        )
+    assert world.body_count() == 1
+    with pytest.raises(ValueError, match="non-finite input: tool pose"):
+        world.set_tool_pose(tool, [np.nan, 0.0, 0.0])
+    with pytest.raises(ValueError, match="zero quaternion"):
+        ts.Pose([0, 0, 0], (0.0, 0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match=r"particle index \d+ out of range"):
+        world.fix_particles(b, [0, 10_000])
+    assert not world.body(b).fixed_flags().any()
+    with pytest.raises(ValueError, match="unknown body id 7"):
+        world.body(7)
+    with pytest.raises(ValueError, match="unknown tool id 3"):
+        world.set_tool_pose(3, [0, 0, 0])
+    with pytest.raises(ValueError, match="set_body_state needs"):
+        world.set_body_state(b, np.zeros((3, 3)), np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="cannot restore state"):
+        world.restore_state(saved[:-1] + bytes([saved[-1] ^ 1]))
+    with pytest.raises(ValueError, match=r"friction"):
+        world.set_tool_friction(tool, 0.1, 0.5)
+    with pytest.raises(ValueError, match="a blade is a capsule or a cylinder"):
+        world.make_blade(tool)
+    with pytest.raises(ValueError, match=r"settings\.dt"):
+        ts.World(ts.Settings(dt=-1.0))
+    with pytest.raises(ValueError, match=r"radius"):
+        ts.ToolShape.Sphere(-1.0)
+    with pytest.raises(TypeError, match="expected a ToolId"):
+        world.tool("probe")
+    assert world.save_state() == saved, "nothing changed"
+
+
+def test_a_diverged_step_raises_and_is_rolled_back():
+    world = ts.World(ts.Settings(gravity=[0.0, 0.0, 0.0]))
+    b = small_block(world)
+    body = world.body(b)
+    for _ in range(3):
+        world.step()
+    x = body.positions()
+    # 20 m/s on a 5 cm block: 400 body sizes per second, over the 250 of the speed bound.
+    v = np.zeros_like(x)
+    v[:, 0] = 20.0
+    world.set_body_state(b, x, v)
+    saved = world.save_state()
+    with pytest.raises(ts.DivergedError, match="step diverged and was rolled back") as e:
+        world.step()
+    assert isinstance(e.value, RuntimeError)
+    assert world.save_state() == saved
+    assert world.diverged_steps() == 1
