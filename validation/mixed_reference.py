@@ -284,12 +284,42 @@ def run_mesh(prefix, name, base, mesh_file, nus, args, mesh_extra=None):
     return ok
 
 
+TABLE_ORDER = ('liver1k6', 'liver4k', 'liver10k', 'organ_c0133', 'organ_c0095', 'organ_c0068', 'kidney_gmsh',
+               'liver_gmsh')
+
+
+def print_table(out):
+    """Markdown table of every {prefix}_th.json in `out` (validation/README.md section g)."""
+    import glob
+    import json
+    rows = []
+    for path in sorted(glob.glob(os.path.join(out, '*_th.json'))):
+        with open(path) as fh:
+            j = json.load(fh)
+        prefix = os.path.basename(path)[:-len('_th.json')]
+        rank = TABLE_ORDER.index(prefix) if prefix in TABLE_ORDER else len(TABLE_ORDER)
+        rows.append((rank, prefix, j))
+    print('| mesh | nodes | nu | **P1 vs TH** | P2 vs TH | P1 max nodal error | P2 max nodal error | max \\|u\\| TH '
+          '| P1 / P2 best-fit scale | TH dofs | TH solve [s] | peak RSS [GB] |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
+    for _, prefix, j in sorted(rows, key=lambda r: r[0]):
+        for tag, r in j['results'].items():
+            c = r['checks']['th']
+            p1, p2 = r['p1_vs_th'], r['p2_vs_th']
+            print('| %s | %s | %g | **%.1f%%** | %.1f%% | %.1f%% | %.1f%% | %.4e | %.2f / %.2f | %s | %.0f | %.1f |'
+                  % (prefix, format(j['mesh']['nodes'], ','), r['nu'], 100 * p1['relative_l2'],
+                     100 * p2['relative_l2'], 100 * p1['max_nodal_error_over_max_u'],
+                     100 * p2['max_nodal_error_over_max_u'], r['th']['max_abs_u'], p1['best_fit_scale_to_ref'],
+                     p2['best_fit_scale_to_ref'], format(c['dofs'], ','), c['solve_s'],
+                     c['process_peak_rss_mb'] / 1024))
+
+
 GMSH_MESHES = dict(kidney_gmsh='kidney_gmsh', liver_gmsh='liver_gmsh')
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('--scene', required=True,
+    ap.add_argument('--scene', default=None,
                     choices=['liver1k6', 'liver4k', 'liver10k', 'organ', 'kidney_gmsh', 'liver_gmsh', 'all'])
     ap.add_argument('--nu', type=float, nargs='+', default=list(NUS))
     ap.add_argument('--check-nu030', action='store_true',
@@ -300,7 +330,13 @@ def main():
     ap.add_argument('--mesh-dir', default=fr.MESH_DIR)
     ap.add_argument('--out', default=fr.OUT)
     ap.add_argument('--p2-dir', default=None, help='also write the displacement-only P2 CSVs solved here to DIR')
+    ap.add_argument('--table', action='store_true', help='print the markdown table of the JSONs in --out and exit')
     args = ap.parse_args()
+    if args.table:
+        print_table(os.path.abspath(args.out))
+        return 0
+    if args.scene is None:
+        ap.error('--scene is required (or --table)')
     fr.OUT = os.path.abspath(args.out)
     fr.DIRECT_ORDERING = 'symmetric-mmd'  # also for the displacement-only P1/P2 solves made here
     os.makedirs(fr.OUT, exist_ok=True)

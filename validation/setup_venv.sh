@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Create (idempotently) the validation virtual environment at build/venv-validation (relative to the repo
-# root) and install pinned versions of scikit-fem, numpy, scipy, matplotlib, pyamg, pypbd and gmsh from PyPI.
+# root) and install pinned versions of scikit-fem, numpy, scipy, matplotlib, pyamg, pypbd, pymetis and gmsh from PyPI.
 #
 #   validation/setup_venv.sh            # create or update; safe to re-run
 #   PYTHON=python3.11 validation/setup_venv.sh
@@ -21,11 +21,12 @@ PINS=(
   "matplotlib==3.11.2"
   "pyamg==5.4.1"
   "pypbd==2.2.2"
+  "pymetis==2025.2.2"  # fem_reference/mixed_reference: nested-dissection ordering for SuperLU
   "gmsh==4.15.2"  # validation/gmsh_organs.py: the meshes from a second mesher (manylinux wheel, no dependencies)
   # their dependencies, pinned too so a re-run installs the same set
   "contourpy==1.3.3" "cycler==0.12.1" "fonttools==4.68.0" "kiwisolver==1.5.1" "packaging==26.3"
   "pillow==13.0.0" "pygame==2.6.1" "PyOpenGL==3.1.10" "pyparsing==3.3.3" "python-dateutil==4.0.0"
-  "tzdata==2026.6"
+  "tzdata==2026.6" "typing-extensions==4.16.0"
 )
 
 have_venv_support() {
@@ -66,4 +67,4 @@ then
 else
   "$VENV/bin/python" -m pip install --disable-pip-version-check "${PINS[@]}"
 fi
-"$VENV/bin/python" -c 'import numpy, scipy, skfem, pyamg, matplotlib, pypbd, gmsh; print("setup_venv: ok: numpy", numpy.__version__, "scipy", scipy.__version__, "scikit-fem", skfem.__version__)'
+"$VENV/bin/python" -c 'import numpy, scipy, skfem, pyamg, matplotlib, pypbd, gmsh, pymetis; print("setup_venv: ok: numpy", numpy.__version__, "scipy", scipy.__version__, "scikit-fem", skfem.__version__)'
