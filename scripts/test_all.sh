@@ -36,4 +36,7 @@ examples_c/test_install.sh
 section "FMU (fmu/test.sh: build TissueSim.fmu, fmpy validate and simulate)"
 fmu/test.sh
 
+section "Python (python/test.sh: the wheel in build/venv-python, ruff, pytest, viewer under Xvfb)"
+python/test.sh
+
 section "all suites passed"

@@ -294,7 +294,7 @@ fn mesh_write_vtu(
         )));
     }
     let s = point_data(point_scalars, x.len(), scalars)?;
-    let v = point_data(point_vectors, x.len(), |a, name| vec3s(a, name))?;
+    let v = point_data(point_vectors, x.len(), vec3s)?;
     let s: Vec<(&str, &[Real])> = s.iter().map(|(k, v)| (k.as_str(), v.as_slice())).collect();
     let v: Vec<(&str, &[Vec3])> = v.iter().map(|(k, v)| (k.as_str(), v.as_slice())).collect();
     core::write_vtu(&path, &x, &t, &s, &v).map_err(|e| io_error(&path, e))

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import MESHES
 
 import tissuesim as ts
+from conftest import MESHES
 
 
 def small_block(world: ts.World) -> ts.BodyId:
@@ -199,9 +199,7 @@ def test_a_shared_model_builds_the_same_body():
     model = world.body(b).load_time_model()
     other = ts.World()
     c = other.add_body_model(model)
-    np.testing.assert_array_equal(
-        other.body(c).rest_positions(), world.body(b).rest_positions()
-    )
+    np.testing.assert_array_equal(other.body(c).rest_positions(), world.body(b).rest_positions())
     built = ts.BodyModel(ts.mesh.lattice_box([0, 0, 0], [0.04, 0.02, 0.02], [4, 2, 2]))
     assert built.particle_count() == model.particle_count()
 

@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 import pytest
+
 from conftest import ROOT
 
 if os.environ.get("TISSUESIM_REQUIRE_VIEW") != "1":

@@ -58,11 +58,7 @@ def test_the_stubs_declare_every_public_name():
             missing.append(name)
             continue
         if inspect.isclass(obj) and not issubclass(obj, BaseException):
-            own = {
-                m
-                for m in vars(obj)
-                if not m.startswith("_") and m not in ("value", "name")
-            }
+            own = {m for m in vars(obj) if not m.startswith("_") and m not in ("value", "name")}
             missing += [f"{name}.{m}" for m in sorted(own - stubs[name])]
     assert not missing, f"not in {STUB.name}: {missing}"
 

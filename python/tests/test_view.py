@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 import pytest
+
 from conftest import ROOT
 
 REQUIRED = os.environ.get("TISSUESIM_REQUIRE_VIEW") == "1"

@@ -5,12 +5,10 @@ shape (n, 3) in the mesh's node order (row k is the mesh's node k, as in the C A
 arrays are uint32. Inputs accept any array-like (lists, tuples, arrays of any real dtype).
 """
 
-from __future__ import annotations
-
 import enum
 import os
 from collections.abc import Sequence
-from typing import Any, Final, Optional, Union
+from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
@@ -18,14 +16,11 @@ import numpy.typing as npt
 __version__: Final[str]
 
 ArrayLike = npt.ArrayLike
-Vec3Like = Union[Sequence[float], npt.NDArray[np.floating[Any]]]
+Vec3Like = Sequence[float] | npt.NDArray[np.floating[Any]]
 Float2D = npt.NDArray[np.float64]
 Float1D = npt.NDArray[np.float64]
 Index2D = npt.NDArray[np.uint32]
-PathLike = Union[str, os.PathLike[str]]
-BodyIdLike = Union[BodyId, int]
-ToolIdLike = Union[ToolId, int]
-RenderSurfaceIdLike = Union[RenderSurfaceId, int]
+PathLike = str | os.PathLike[str]
 
 class MeshError(OSError):
     """A mesh file could not be read or is malformed (the message names the file and line)."""
@@ -136,11 +131,11 @@ class BodyOptions:
 
     material: Material
     """The material. Default ``Material()`` (liver-like)."""
-    support_radius: Optional[float]
+    support_radius: float | None
     """Support radius of every particle (m); None chooses one per particle. Default None."""
     target_neighbours: int
     """Target neighbours when the support radius is automatic. Default 20."""
-    particle_radius: Optional[float]
+    particle_radius: float | None
     """Contact radius of the particles (m); None: half the mean edge. Default None."""
     consistent_gradients: bool
     """Variationally consistent MLS gradients. Default True."""
@@ -148,9 +143,9 @@ class BodyOptions:
         self,
         *,
         material: Material = ...,
-        support_radius: Optional[float] = ...,
+        support_radius: float | None = ...,
         target_neighbours: int = ...,
-        particle_radius: Optional[float] = ...,
+        particle_radius: float | None = ...,
         consistent_gradients: bool = ...,
     ) -> None: ...
     def validate(self) -> None:
@@ -218,7 +213,7 @@ class Body:
 class BodyModel:
     """A body's immutable load-time data, shared by every body built on it."""
 
-    def __init__(self, mesh: TetMesh, options: Optional[BodyOptions] = None) -> None:
+    def __init__(self, mesh: TetMesh, options: BodyOptions | None = None) -> None:
         """Build the model (GIL released; ``ValueError`` for a bad mesh or options)."""
     def particle_count(self) -> int: ...
     def rest_positions(self) -> Float2D:
@@ -226,7 +221,7 @@ class BodyModel:
     def tets(self) -> Index2D:
         """Tetrahedra (m, 4), node indices."""
     def options(self) -> BodyOptions: ...
-    def is_built_from(self, mesh: TetMesh, options: Optional[BodyOptions] = None) -> bool: ...
+    def is_built_from(self, mesh: TetMesh, options: BodyOptions | None = None) -> bool: ...
     def heap_bytes(self) -> int:
         """Heap memory held (bytes)."""
 
@@ -306,8 +301,8 @@ def mesh_write_vtu(
     path: PathLike,
     positions: ArrayLike,
     tets: ArrayLike,
-    point_scalars: Optional[dict[str, ArrayLike]] = None,
-    point_vectors: Optional[dict[str, ArrayLike]] = None,
+    point_scalars: dict[str, ArrayLike] | None = None,
+    point_vectors: dict[str, ArrayLike] | None = None,
 ) -> None:
     """Write a volume mesh for ParaView: positions (n, 3) m, tets (m, 4), point data."""
 
@@ -339,7 +334,7 @@ class ToolShape:
         """A triangle mesh read from OBJ, positions times ``scale``."""
     @property
     def kind(self) -> str:
-        """"Sphere", "Capsule", "Cylinder", "Cuboid", "ConvexHull" or "TriMesh"."""
+        """ "Sphere", "Capsule", "Cylinder", "Cuboid", "ConvexHull" or "TriMesh"."""
     def parameters(self) -> dict[str, Any]:
         """The variant's fields (m; arrays as numpy arrays)."""
 
@@ -366,7 +361,7 @@ class Pose:
     def transform_point(self, point: Vec3Like) -> Float1D:
         """A point of the tool's frame (m) in the world frame."""
 
-PoseLike = Union[Pose, Vec3Like]
+PoseLike = Pose | Vec3Like
 
 class ToolOptions:
     """Friction and sampling of a tool."""
@@ -375,14 +370,14 @@ class ToolOptions:
     """Static friction coefficient μ_s (dimensionless). Default 0."""
     friction_kinetic: float
     """Kinetic friction coefficient μ_k ≤ μ_s (dimensionless). Default 0."""
-    sample_spacing: Optional[float]
+    sample_spacing: float | None
     """Surface sample spacing (m) of the sampled contact mode; None: particle radius."""
     def __init__(
         self,
         *,
         friction_static: float = ...,
         friction_kinetic: float = ...,
-        sample_spacing: Optional[float] = ...,
+        sample_spacing: float | None = ...,
     ) -> None: ...
     def validate(self) -> None: ...
 
@@ -426,17 +421,17 @@ class Tool:
 class GraspOptions:
     """How a tool grasps."""
 
-    reach: Optional[float]
+    reach: float | None
     """Particles within this distance (m) of the tool are held; None: 1.5 particle radii."""
-    compliance: Optional[float]
+    compliance: float | None
     """Compliance of each attachment (m/N); None: that of the tissue around it."""
     max_force: float
     """Largest total pull (N) before the tissue slips; infinity never slips."""
     def __init__(
         self,
         *,
-        reach: Optional[float] = ...,
-        compliance: Optional[float] = ...,
+        reach: float | None = ...,
+        compliance: float | None = ...,
         max_force: float = ...,
     ) -> None: ...
     def validate(self) -> None: ...
@@ -448,14 +443,14 @@ class NeedleOptions:
     """Axial force (N) on the tip that punctures the tissue. Default 1."""
     friction_per_length: float
     """Axial friction per inserted length (N/m). Default 20."""
-    reach: Optional[float]
+    reach: float | None
     """Hold radius around the shaft (m); None: radius + 1.5 particle radii."""
     def __init__(
         self,
         *,
         puncture_force: float = ...,
         friction_per_length: float = ...,
-        reach: Optional[float] = ...,
+        reach: float | None = ...,
     ) -> None: ...
     def validate(self) -> None: ...
 
@@ -474,9 +469,7 @@ class NeedleState:
 class Blade:
     """A blade's edge at the start and at the end of its motion (m, world frame)."""
 
-    def __init__(
-        self, from_: tuple[Vec3Like, Vec3Like], to: tuple[Vec3Like, Vec3Like]
-    ) -> None: ...
+    def __init__(self, from_: tuple[Vec3Like, Vec3Like], to: tuple[Vec3Like, Vec3Like]) -> None: ...
     @property
     def from_(self) -> Float2D:
         """The edge's ends at the start (2, 3), m."""
@@ -584,6 +577,10 @@ class RenderSurfaceId:
     def __index__(self) -> int: ...
     def __hash__(self) -> int: ...
 
+BodyIdLike = BodyId | int
+ToolIdLike = ToolId | int
+RenderSurfaceIdLike = RenderSurfaceId | int
+
 class StepReport:
     """What one step did."""
 
@@ -631,7 +628,7 @@ class World:
     ``cut``; another thread calling into the same world meanwhile gets ``RuntimeError``.
     """
 
-    def __init__(self, settings: Optional[Settings] = None) -> None:
+    def __init__(self, settings: Settings | None = None) -> None:
         """An empty world (``ValueError`` for invalid settings)."""
     def settings(self) -> Settings:
         """The settings in force (a copy)."""
@@ -639,14 +636,12 @@ class World:
     def time(self) -> float:
         """Simulated time (s)."""
     def diverged_steps(self) -> int: ...
-    def add_body(self, mesh: TetMesh, options: Optional[BodyOptions] = None) -> BodyId:
+    def add_body(self, mesh: TetMesh, options: BodyOptions | None = None) -> BodyId:
         """Add a deformable body from ``mesh`` (m)."""
     def add_body_model(self, model: BodyModel) -> BodyId: ...
     def body_count(self) -> int: ...
     def body(self, id: BodyIdLike) -> Body: ...
-    def set_body_state(
-        self, body: BodyIdLike, positions: ArrayLike, velocities: ArrayLike
-    ) -> None:
+    def set_body_state(self, body: BodyIdLike, positions: ArrayLike, velocities: ArrayLike) -> None:
         """Positions (n, 3) m and velocities (n, 3) m/s in node order; nothing changes on
         error."""
     def add_render_surface(self, body: BodyIdLike, mesh: RenderMesh) -> RenderSurfaceId: ...
@@ -658,14 +653,14 @@ class World:
     def fix_box(self, body: BodyIdLike, min: Vec3Like, max: Vec3Like) -> int:
         """Fix the particles inside [min, max] (m); returns how many."""
     def add_tool(
-        self, shape: ToolShape, pose: PoseLike, options: Optional[ToolOptions] = None
+        self, shape: ToolShape, pose: PoseLike, options: ToolOptions | None = None
     ) -> ToolId: ...
     def remove_tool(self, tool: ToolIdLike) -> None: ...
     def cut(self, body: BodyIdLike, blade: Blade) -> CutReport: ...
     def make_blade(self, tool: ToolIdLike) -> None: ...
-    def make_needle(self, tool: ToolIdLike, options: Optional[NeedleOptions] = None) -> None: ...
+    def make_needle(self, tool: ToolIdLike, options: NeedleOptions | None = None) -> None: ...
     def needle_state(self, tool: ToolIdLike) -> NeedleState: ...
-    def grasp(self, tool: ToolIdLike, options: Optional[GraspOptions] = None) -> int:
+    def grasp(self, tool: ToolIdLike, options: GraspOptions | None = None) -> int:
         """Hold the tissue within reach; returns how many particles."""
     def release(self, tool: ToolIdLike) -> None: ...
     def grasped_count(self, tool: ToolIdLike) -> int: ...

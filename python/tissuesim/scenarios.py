@@ -43,9 +43,7 @@ class Scene:
         x = body.positions()
         self.lo, self.hi = x.min(axis=0), x.max(axis=0)
         top = self.hi[1] - 0.15 * (self.hi[1] - self.lo[1])
-        self.world.fix_box(
-            self.organ, [self.lo[0] - 1, top, self.lo[2] - 1], self.hi + 1.0
-        )
+        self.world.fix_box(self.organ, [self.lo[0] - 1, top, self.lo[2] - 1], self.hi + 1.0)
         if state is not None:
             self.world.restore_state(state)
         elif settle:

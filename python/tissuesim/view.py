@@ -36,9 +36,7 @@ def _pyvista():
     try:
         import pyvista as pv
     except ImportError as e:  # pragma: no cover - exercised only without the extra
-        raise SystemExit(
-            "tissuesim.view needs pyvista: pip install 'pyvista>=0.43' imageio"
-        ) from e
+        raise SystemExit("tissuesim.view needs pyvista: pip install 'pyvista>=0.43' imageio") from e
     return pv
 
 
@@ -94,22 +92,27 @@ class View:
         self.plotter.set_background(BACKGROUND)
         surface = scene.world.update_render_surface(scene.surface)
         self.organ = pv.PolyData(surface.positions(), faces(surface.triangles()))
-        self.plotter.add_mesh(
-            self.organ, color=ORGAN_COLOUR, smooth_shading=True, specular=0.3
-        )
+        self.plotter.add_mesh(self.organ, color=ORGAN_COLOUR, smooth_shading=True, specular=0.3)
         self.tools: dict[int, object] = {}
         self.arrow = pv.Arrow()
         self.arrow_actor = self.plotter.add_mesh(self.arrow, color=ARROW_COLOUR)
         self.arrow_actor.visibility = False
         self.text = self.plotter.add_text("", position="upper_left", font_size=10, color="black")
-        self.plotter.camera_position = [(0.12, 0.10, 0.42), (0.0, -0.01, 0.0), (0.0, 1.0, 0.0)]
+        # From the right, in front and a little above: the front face (+z), where the tools
+        # work, in profile.
+        self.plotter.camera_position = [(0.42, 0.10, 0.26), (0.0, -0.02, 0.02), (0.0, 1.0, 0.0)]
 
     def update(self) -> None:
         """Redraw the organ, the tools and the arrow from the world's current state."""
         pv = _pyvista()
         world: World = self.scene.world
-        surface = world.update_render_surface(self.scene.surface)
-        self.organ.points = surface.positions()
+        body = world.body(self.scene.organ)
+        if body.cut_counts()[1] > 0:
+            # A render surface is bound once and does not follow a cut: draw the body's own
+            # boundary, rebuilt by the cut, instead.
+            self.organ.copy_from(pv.PolyData(body.positions(), faces(body.boundary_triangles())))
+        else:
+            self.organ.points = world.update_render_surface(self.scene.surface).positions()
         live = set()
         for tid in world.tool_ids():
             tool = world.tool(tid)
