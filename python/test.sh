@@ -23,7 +23,8 @@ apt_install() {
     if [ -z "$APT_UPDATED" ]; then $SUDO apt-get update -qq; APT_UPDATED=1; fi
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "$@" >/dev/null
 }
-step() { printf -- '--- python: %s\n' "$*"; }
+START=$SECONDS
+step() { printf -- '--- python: %s (at %ds)\n' "$*" "$((SECONDS - START))"; }
 
 # What the viewer needs off-screen: a virtual X server and Mesa's OpenGL (llvmpipe).
 missing=()
@@ -68,6 +69,7 @@ step "pytest python/tests (under xvfb-run)"
 status=0
 TISSUESIM_REQUIRE_VIEW=1 xvfb-run -a -s "-screen 0 1280x1024x24" \
     "$VENV/bin/python" -m pytest python/tests -q -p no:cacheprovider "$@" || status=$?
+step "done (pytest exit code $status)"
 if [ "$status" = 5 ]; then
     echo "python/test.sh: pytest collected no test" >&2
 fi

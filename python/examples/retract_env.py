@@ -57,7 +57,9 @@ class RetractEnv(_Base):
 
     def __init__(self) -> None:
         if spaces is not None:
-            self.observation_space = spaces.Box(-np.inf, np.inf, shape=(6,), dtype=np.float32)
+            # Displacements within ±1 m, forces within ±100 N (the grasp slips at 3 N).
+            high = np.array([1.0, 1.0, 1.0, 100.0, 100.0, 100.0], dtype=np.float32)
+            self.observation_space = spaces.Box(-high, high, dtype=np.float32)
             self.action_space = spaces.Box(-MAX_SPEED, MAX_SPEED, shape=(3,), dtype=np.float32)
         # Settle once per process: every episode starts from the same hanging organ.
         if RetractEnv._rest_state is None:

@@ -1,4 +1,5 @@
-"""python/README.md's Python code blocks run as written from the repository root."""
+"""The Python code blocks of python/README.md and of the repository's README run as written
+from the repository root."""
 
 from __future__ import annotations
 
@@ -10,12 +11,16 @@ import pytest
 
 from conftest import ROOT
 
-README = ROOT / "python" / "README.md"
-BLOCKS = re.findall(r"^```python\n(.*?)^```", README.read_text(), flags=re.S | re.M)
+READMES = [ROOT / "python" / "README.md", ROOT / "README.md"]
+BLOCKS = [
+    block
+    for readme in READMES
+    for block in re.findall(r"^```python\n(.*?)^```", readme.read_text(), flags=re.S | re.M)
+]
 
 
-def test_the_readme_has_python_examples():
-    assert len(BLOCKS) >= 3
+def test_the_readmes_have_python_examples():
+    assert len(BLOCKS) >= 5
 
 
 @pytest.mark.parametrize("index", range(len(BLOCKS)))
