@@ -19,6 +19,7 @@ mod mesh;
 mod render;
 mod settings;
 mod state;
+mod statics;
 mod tool;
 mod world;
 
@@ -35,6 +36,7 @@ fn _tissuesim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     body::register(m)?;
     render::register(m)?;
     state::register(m)?;
+    statics::register(m)?;
     world::register(m)?;
     bench::register(m)?;
     Ok(())

@@ -300,6 +300,32 @@ fn mesh_write_vtu(
     core::write_vtu(&path, &x, &t, &s, &v).map_err(|e| io_error(&path, e))
 }
 
+/// Write a triangulated surface for ParaView as VTU: `positions` (n, 3) m, `triangles` (k, 3),
+/// and optional per-point data `{name: (n,)}` and `{name: (n, 3)}`.
+#[pyfunction]
+#[pyo3(signature = (path, positions, triangles, point_scalars = None, point_vectors = None))]
+fn mesh_write_vtu_surface(
+    path: PathBuf,
+    positions: &Bound<'_, PyAny>,
+    triangles: &Bound<'_, PyAny>,
+    point_scalars: Option<&Bound<'_, PyDict>>,
+    point_vectors: Option<&Bound<'_, PyDict>>,
+) -> PyResult<()> {
+    let x = vec3s(positions, "positions")?;
+    let t = indices::<3>(triangles, "triangles")?;
+    if let Some(bad) = t.iter().flatten().find(|&&k| k as usize >= x.len()) {
+        return Err(PyValueError::new_err(format!(
+            "triangles: index {bad} out of range ({} points)",
+            x.len()
+        )));
+    }
+    let s = point_data(point_scalars, x.len(), scalars)?;
+    let v = point_data(point_vectors, x.len(), vec3s)?;
+    let s: Vec<(&str, &[Real])> = s.iter().map(|(k, v)| (k.as_str(), v.as_slice())).collect();
+    let v: Vec<(&str, &[Vec3])> = v.iter().map(|(k, v)| (k.as_str(), v.as_slice())).collect();
+    core::write_vtu_surface(&path, &x, &t, &s, &v).map_err(|e| io_error(&path, e))
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<TetMesh>()?;
     m.add_class::<MeshReport>()?;
@@ -311,5 +337,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh_read_obj, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_write_vtk, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_write_vtu, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_write_vtu_surface, m)?)?;
     Ok(())
 }

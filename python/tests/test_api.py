@@ -289,3 +289,35 @@ def test_a_diverged_step_raises_and_is_rolled_back():
     assert isinstance(e.value, RuntimeError)
     assert world.save_state() == saved
     assert world.diverged_steps() == 1
+
+
+def test_linear_statics_in_node_order_match_a_slow_settle():
+    # The particles carry λ (no volume constraints): the discretisation the linear solve has.
+    world = ts.World(ts.Settings(volume_constraints=False))
+    b = world.add_body(
+        ts.mesh.lattice_box([0, 0, 0], [0.08, 0.02, 0.02], [8, 2, 2]),
+        ts.BodyOptions(material=ts.Material(youngs_modulus=2e5)),
+    )
+    body = world.body(b)
+    world.fix_particles(b, np.flatnonzero(body.rest_positions()[:, 0] == 0.0))
+    sag = ts.statics.linear_gravity_sag(body, [0.0, -9.81, 0.0])
+    assert sag.shape == (body.particle_count(), 3)
+    assert np.all(sag[body.fixed_flags()] == 0.0)
+    tip = int(np.argmax(body.rest_positions()[:, 0]))
+    assert sag[tip, 1] < 0.0, "the free end goes down"
+    world.settle()
+    u = body.positions() - body.rest_positions()
+    # A small sag (stiff block): the nonlinear equilibrium's vertical displacement is close to
+    # the linear one's, node for node (so both are in the same order; along x the rotation of
+    # the bent block makes them differ).
+    assert abs(u[tip, 1] - sag[tip, 1]) < 0.02 * abs(sag[tip, 1])
+    assert np.abs(u[:, 1] - sag[:, 1]).max() < 0.02 * np.abs(sag[:, 1]).max()
+    load = body.masses()[:, None] * np.array([0.0, -9.81, 0.0])
+    same = ts.statics.linear_response(body, load, np.zeros_like(load))
+    np.testing.assert_allclose(same, sag, rtol=1e-9, atol=1e-15)
+
+
+def test_the_constants_are_the_libraries():
+    assert ts.MAX_POISSON_RATIO == 0.49 and ts.MIN_POISSON_RATIO == 0.0
+    assert ts.YOUNGS_MODULUS_RANGE == (1e-6, 1e12)
+    assert ts.statics.SETTLE_SPEED > 0

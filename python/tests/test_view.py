@@ -59,3 +59,8 @@ def test_a_gif_has_one_frame_per_k_steps(tmp_path):
     frames = imageio.imread(path, index=None)
     assert len(frames) >= 4
     assert organ_pixels(frames[-1]) > 0.03
+
+
+def test_the_live_window_with_the_mouse_probe_runs_and_closes():
+    run = view("--scenario", "probe", "--no-settle", "--duration", "2", "--size", "320", "240")
+    assert run.stderr.count("Traceback") == 0

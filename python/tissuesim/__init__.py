@@ -9,8 +9,21 @@ numpy arrays of shape (n, 3), float64, in the mesh's node order (row k is the me
 >>> organ = world.add_body(ts.mesh.default_organ())
 """
 
-from . import mesh, render
+from . import mesh, render, statics
 from ._tissuesim import (
+    CONVEX_HULL_FLATNESS,
+    DENSITY_RANGE,
+    MAX_NEIGHBOURS,
+    MAX_POISSON_RATIO,
+    MIN_POISSON_RATIO,
+    MIN_QUATERNION_NORM,
+    PARTICLE_RADIUS_RANGE,
+    STATE_POSITION_LIMIT,
+    STATE_SPEED_LIMIT,
+    SUPPORT_RADIUS_RANGE,
+    TOOL_JUMP_FRACTION,
+    TOOL_SIZE_RANGE,
+    YOUNGS_MODULUS_RANGE,
     Blade,
     Body,
     BodyId,
@@ -42,6 +55,19 @@ from ._tissuesim import (
 )
 
 __all__ = [
+    "CONVEX_HULL_FLATNESS",
+    "DENSITY_RANGE",
+    "MAX_NEIGHBOURS",
+    "MAX_POISSON_RATIO",
+    "MIN_POISSON_RATIO",
+    "MIN_QUATERNION_NORM",
+    "PARTICLE_RADIUS_RANGE",
+    "STATE_POSITION_LIMIT",
+    "STATE_SPEED_LIMIT",
+    "SUPPORT_RADIUS_RANGE",
+    "TOOL_JUMP_FRACTION",
+    "TOOL_SIZE_RANGE",
+    "YOUNGS_MODULUS_RANGE",
     "Blade",
     "Body",
     "BodyId",
@@ -72,4 +98,5 @@ __all__ = [
     "__version__",
     "mesh",
     "render",
+    "statics",
 ]

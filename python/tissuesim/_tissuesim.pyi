@@ -15,6 +15,41 @@ import numpy.typing as npt
 
 __version__: Final[str]
 
+MIN_POISSON_RATIO: Final[float]
+"""Smallest Poisson ratio a body accepts (0)."""
+MAX_POISSON_RATIO: Final[float]
+"""Largest Poisson ratio a body accepts (0.49)."""
+YOUNGS_MODULUS_RANGE: Final[tuple[float, float]]
+"""Accepted Young's moduli (Pa)."""
+DENSITY_RANGE: Final[tuple[float, float]]
+"""Accepted densities (kg/m³)."""
+PARTICLE_RADIUS_RANGE: Final[tuple[float, float]]
+"""Accepted particle radii, in mean tetrahedron edge lengths."""
+SUPPORT_RADIUS_RANGE: Final[tuple[float, float]]
+"""Accepted support radii, in mean tetrahedron edge lengths."""
+STATE_POSITION_LIMIT: Final[float]
+"""Largest distance of a set particle from the rest centre, in body sizes."""
+STATE_SPEED_LIMIT: Final[float]
+"""Largest speed of a set particle, in body sizes per second."""
+TOOL_SIZE_RANGE: Final[tuple[float, float]]
+"""Accepted tool radii, half-heights and half-extents (m)."""
+MIN_QUATERNION_NORM: Final[float]
+"""Quaternions of a smaller norm are rejected as zero."""
+CONVEX_HULL_FLATNESS: Final[float]
+"""Relative flatness below which convex-hull points count as coplanar."""
+MAX_NEIGHBOURS: Final[int]
+"""Most neighbours a particle may have."""
+TOOL_JUMP_FRACTION: Final[float]
+"""Fraction of the divergence speed bound above which a tool motion is a jump."""
+SETTLE_TOLERANCE: Final[float]
+"""Relative residual at which settle's Newton iterations stop."""
+SETTLE_MAX_ITERATIONS: Final[int]
+"""Newton iterations per body in settle."""
+SETTLE_SPEED: Final[float]
+"""Speed (m/s) below which settle's relaxation stops."""
+SETTLE_MAX_STEPS: Final[int]
+"""Most relaxation steps in settle."""
+
 ArrayLike = npt.ArrayLike
 Vec3Like = Sequence[float] | npt.NDArray[np.floating[Any]]
 Float2D = npt.NDArray[np.float64]
@@ -305,6 +340,23 @@ def mesh_write_vtu(
     point_vectors: dict[str, ArrayLike] | None = None,
 ) -> None:
     """Write a volume mesh for ParaView: positions (n, 3) m, tets (m, 4), point data."""
+
+def mesh_write_vtu_surface(
+    path: PathLike,
+    positions: ArrayLike,
+    triangles: ArrayLike,
+    point_scalars: dict[str, ArrayLike] | None = None,
+    point_vectors: dict[str, ArrayLike] | None = None,
+) -> None:
+    """Write a surface for ParaView: positions (n, 3) m, triangles (k, 3), point data."""
+
+def statics_linear_gravity_sag(body: Body, g: Vec3Like) -> Float2D:
+    """Linear static displacement (n, 3), m, from rest under gravity ``g`` (m/s²), node
+    order (GIL released)."""
+
+def statics_linear_response(body: Body, load: ArrayLike, prescribed: ArrayLike) -> Float2D:
+    """Linear static displacement (n, 3), m: K u = ``load`` (n, 3), N, on free nodes,
+    u = ``prescribed`` (n, 3), m, on fixed ones (node order)."""
 
 # --- tools ----------------------------------------------------------------------------------
 

@@ -11,6 +11,7 @@ from ._tissuesim import mesh_organ_with_cell as organ_with_cell
 from ._tissuesim import mesh_read_obj as read_obj
 from ._tissuesim import mesh_write_vtk as write_vtk
 from ._tissuesim import mesh_write_vtu as write_vtu
+from ._tissuesim import mesh_write_vtu_surface as write_vtu_surface
 
 __all__ = [
     "MeshReport",
@@ -23,4 +24,5 @@ __all__ = [
     "read_obj",
     "write_vtk",
     "write_vtu",
+    "write_vtu_surface",
 ]

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from collections.abc import Sequence
 
 import numpy as np
@@ -166,6 +167,13 @@ def run(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--no-settle", action="store_true", help="start from the rest shape (no settle)"
     )
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="S",
+        help="close the window after S seconds of wall time (default: when closed)",
+    )
     args = parser.parse_args(argv)
     off_screen = bool(args.screenshot or args.gif)
     name = args.scenario or ("press" if off_screen else "probe")
@@ -175,7 +183,7 @@ def run(argv: Sequence[str] | None = None) -> int:
     scene = scenarios.Scene(settle=not args.no_settle)
     view = View(scene, off_screen=off_screen, size=args.size)
     if name == "probe":
-        return _interactive_probe(scene, view)
+        return _interactive_probe(scene, view, args.duration)
 
     kwargs = {} if args.steps is None else {"steps": args.steps}
     script = scenarios.SCENARIOS[name](scene, **kwargs)
@@ -197,13 +205,13 @@ def run(argv: Sequence[str] | None = None) -> int:
     if args.gif:
         view.plotter.write_frame()
         print(f"wrote {args.gif}")
-    if not off_screen:
+    if not off_screen and args.duration is None:
         view.plotter.show()
     view.plotter.close()
     return 0
 
 
-def _interactive_probe(scene: scenarios.Scene, view: View) -> int:
+def _interactive_probe(scene: scenarios.Scene, view: View, duration: float | None) -> int:
     """A 10 mm probe that follows a sphere widget dragged with the mouse."""
     start = np.array([0.0, 0.0, scene.front_face_z(0.0, 0.0) + 0.03])
     probe = scene.world.add_tool(ToolShape.Sphere(0.01), Pose.at(start))
@@ -215,8 +223,10 @@ def _interactive_probe(scene: scenarios.Scene, view: View) -> int:
 
     view.plotter.add_sphere_widget(moved, center=start, radius=0.006, color="yellow")
     view.plotter.show(interactive_update=True, auto_close=False)
-    while view.plotter.render_window is not None and not view.plotter._closed:
-        # Move towards the widget at most 5 mm per step (a hand, not a teleport).
+    end = time.monotonic() + (duration if duration is not None else float("inf"))
+    while time.monotonic() < end and not getattr(view.plotter, "_closed", False):
+        # Towards the widget by at most 5 mm a frame of 10 steps (0.5 m/s: a hand, not a
+        # teleport).
         here = scene.world.tool(probe).pose().position
         delta = target["position"] - here
         step = min(1.0, 0.005 / max(float(np.linalg.norm(delta)), 1e-12))
@@ -225,6 +235,7 @@ def _interactive_probe(scene: scenarios.Scene, view: View) -> int:
             scene.world.step()
         view.update()
         view.plotter.update()
+    view.plotter.close()
     return 0
 
 
