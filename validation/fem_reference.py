@@ -131,8 +131,8 @@ def rigid_modes(x, comp):
 DIRECT_ORDERING = 'colamd'  # or 'symmetric-mmd' (validation/mixed_reference.py): see lu_solve_symmetric
 SYMMETRIC_SOLVER = ('SuperLU in symmetric mode (METIS nested-dissection ordering of A^T + A through pymetis, MMD '
                     'without it; diagonal pivots, diag_pivot_thresh 0), '
-                    'up to 3 steps of iterative refinement, falling back to COLAMD with partial pivoting if the '
-                    'relative residual is still above 1e-10')
+                    'up to 3 steps of iterative refinement (while the relative residual is >= 1e-10), falling '
+                    'back to COLAMD with partial pivoting if it is still above 1e-9')
 
 
 def pymetis_version():
@@ -162,7 +162,7 @@ def lu_solve_symmetric(A, b):
     fill-reducing ordering (METIS nested dissection when pymetis is there, else MMD on A^T + A) and diagonal pivots,
     which keeps the symmetric fill (TH system of liver_1k6 with MMD: 6x faster, 3x less fill than COLAMD with
     partial pivoting; of the organ c0068: nested dissection 75 s, MMD more than 16 min). Up to 3 steps of iterative refinement with the same factors,
-    then COLAMD + partial pivoting if the residual is still not below 1e-10. Returns (x, description)."""
+    then COLAMD + partial pivoting if the residual is still not below 1e-9. Returns (x, description)."""
     perm = nested_dissection(A)
     if perm is not None:
         ordering = 'METIS nested dissection (pymetis %s)' % pymetis_version()
@@ -187,11 +187,14 @@ def lu_solve_symmetric(A, b):
         steps += 1
     nnz = lu.nnz
     del lu, lu_solve
-    if res < 1e-10:
+    # Displacement-only P2 at nu 0.499 stalls near 1e-9 after refinement (COLAMD with partial pivoting gets no
+    # better: 7.8e-10 on the organ c0095), so accept 1e-9 (the checks ask for 1e-8).
+    if res < 1e-9:
         return x, SYMMETRIC_SOLVER + ': symmetric mode used, ordering %s (nnz(L+U) %d, %d refinement steps)' % (
             ordering, nnz, steps)
     x = spla.spsolve(A, b, permc_spec='COLAMD')
-    return x, SYMMETRIC_SOLVER + ': residual %.1e in symmetric mode, COLAMD used' % res
+    return x, SYMMETRIC_SOLVER + ': residual %.1e in symmetric mode after %d refinement steps, COLAMD used' % (
+        res, steps)
 
 
 def dof_components(basis, order):
