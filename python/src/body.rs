@@ -166,6 +166,9 @@ impl Body {
     /// Whether `point` (3,), m, is inside the deformed body.
     fn contains(&self, py: Python<'_>, point: &Bound<'_, PyAny>) -> PyResult<bool> {
         let p = vec3(point, "point")?;
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(tissuesim::Error::NonFinite("contains: point".into())).py();
+        }
         self.with(py, |b| b.contains(&p))
     }
     /// Neighbour pairs cut and tetrahedra removed so far.

@@ -216,9 +216,9 @@ fn mesh_lattice_box(
             "lattice_box: min and max must be finite with min < max on every axis",
         ));
     }
-    if cells.iter().any(|&c| c == 0 || c > 1000) || cells.iter().product::<usize>() > 10_000_000 {
+    if cells.iter().any(|&c| c == 0 || c > 1000) || cells.iter().product::<usize>() > 1_000_000 {
         return Err(PyValueError::new_err(format!(
-            "lattice_box: cells must be in 1..=1000 per axis and at most 10^7 in all, got {cells:?}"
+            "lattice_box: cells must be in 1..=1000 per axis and at most 10^6 in all, got {cells:?}"
         )));
     }
     Ok(TetMesh {

@@ -391,6 +391,12 @@ impl Tool {
         point: &Bound<'_, PyAny>,
     ) -> PyResult<Real> {
         let p: Vec3 = vec3(point, "point")?;
+        if !p.iter().all(|c| c.is_finite()) || !pose.inner.is_valid() {
+            return Err(tissuesim::Error::NonFinite(
+                "signed_distance: point or pose".into(),
+            ))
+            .py();
+        }
         self.with(py, |t| t.signed_distance(&pose.inner, &p))
     }
     fn __repr__(&self) -> String {

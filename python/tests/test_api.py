@@ -321,3 +321,75 @@ def test_the_constants_are_the_libraries():
     assert ts.MAX_POISSON_RATIO == 0.49 and ts.MIN_POISSON_RATIO == 0.0
     assert ts.YOUNGS_MODULUS_RANGE == (1e-6, 1e12)
     assert ts.statics.SETTLE_SPEED > 0
+
+
+def test_hostile_inputs_raise_python_errors_never_a_panic():
+    """NaN, infinities, huge and negative numbers, wrong types and shapes everywhere: each
+    call either works or raises an ordinary exception (a Rust panic would surface as
+    ``pyo3_runtime.PanicException``, a ``BaseException``, and fail this test)."""
+    world = ts.World()
+    b = small_block(world)
+    body = world.body(b)
+    tool = world.add_tool(ts.ToolShape.Capsule(0.01, 0.002), [0.0, 0.1, 0.0])
+    nan, inf = float("nan"), float("inf")
+    calls = [
+        lambda: world.fix_box(b, [nan, 0, 0], [1, 1, 1]),
+        lambda: world.fix_particles(b, [-1]),
+        lambda: world.fix_particles(b, [2**40]),
+        lambda: world.fix_particles(b, [[0.5]]),
+        lambda: world.set_body_state(b, np.full((body.particle_count(), 3), nan), np.zeros(3)),
+        lambda: world.set_body_state(b, body.positions() * 1e9, body.velocities()),
+        lambda: world.set_tool_pose(
+            tool, ts.Pose.interpolate(ts.Pose.at([0, 0, 0]), ts.Pose.at([1, 1, 1]), nan)
+        ),
+        lambda: world.set_tool_pose(tool, [inf, 0, 0]),
+        lambda: world.set_tool_pose(tool, [0, 0]),
+        lambda: world.set_tool_pose(tool, "abc"),
+        lambda: world.set_tool_friction(tool, nan, 0.0),
+        lambda: world.set_body_pair_friction(b, 5, 0.1, 0.1),
+        lambda: world.grasp(tool, ts.GraspOptions(reach=-1.0)),
+        lambda: world.grasp(tool, ts.GraspOptions(max_force=nan)),
+        lambda: world.make_needle(tool, ts.NeedleOptions(puncture_force=inf)),
+        lambda: world.needle_state(tool),
+        lambda: world.cut(b, ts.Blade(from_=([nan, 0, 0], [0, 0, 0]), to=([0, 0, 0], [1, 0, 0]))),
+        lambda: world.tool(tool).signed_distance(ts.Pose.at([0, 0, 0]), [nan, 0, 0]),
+        lambda: body.contains([nan, nan, nan]),
+        lambda: body.is_fixed(10**6),
+        lambda: world.restore_state(b""),
+        lambda: world.restore_state(b"\x00" * 64),
+        lambda: ts.WorldState.from_bytes(b"garbage"),
+        lambda: world.add_render_surface(
+            b, ts.render.RenderMesh.from_boundary([[0, 0, 0]], [[0, 0, 5]])
+        ),
+        lambda: world.render_surface(3),
+        lambda: world.update_render_surface(-1),
+        lambda: ts.ToolShape.ConvexHull([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]),
+        lambda: ts.ToolShape.TriMesh([[0, 0, 0]], [[0, 0, 9]]),
+        lambda: ts.ToolShape.Cuboid([1, 1, nan]),
+        lambda: ts.ToolShape.Capsule(-1, 1),
+        lambda: ts.mesh.lattice_box([0, 0, 0], [1, 1, 1], [10**6, 10**6, 10**6]),
+        lambda: ts.mesh.lattice_box([1, 1, 1], [0, 0, 0], [1, 1, 1]),
+        lambda: ts.mesh.organ_with_cell(nan),
+        lambda: ts.mesh.load("data/meshes/liver_4k.node", -1.0),
+        lambda: ts.mesh.load("data/meshes/liver_4k.node", nan),
+        lambda: ts.mesh.TetMesh(np.zeros((4, 3)), [[0, 1, 2, 3]]).volume(),
+        lambda: world.add_body(ts.mesh.TetMesh(np.zeros((5, 3)), [[0, 1, 2, 3]])),
+        lambda: world.add_body(ts.mesh.TetMesh(np.full((5, 3), nan), [[0, 1, 2, 3]])),
+        lambda: world.set_settings(ts.Settings(threads=0)),
+        lambda: world.set_settings(ts.Settings(dt=inf)),
+        lambda: ts.Settings(threads=-1),
+        lambda: ts.Settings(gravity=[1, 2]),
+        lambda: ts.statics.linear_response(body, np.zeros((2, 3)), np.zeros((2, 3))),
+        lambda: ts.statics.linear_gravity_sag(body, [nan, 0, 0]),
+        lambda: ts.mesh.write_vtu("/nonexistent/dir/x.vtu", [[0, 0, 0]], [[0, 0, 0, 1]]),
+    ]
+    for k, call in enumerate(calls):
+        try:
+            call()
+        except (ValueError, TypeError, OSError, IndexError, OverflowError, RuntimeError):
+            pass
+        except BaseException as e:  # noqa: BLE001 - a panic is what this test looks for
+            raise AssertionError(f"call {k} raised {type(e).__name__}: {e}") from e
+    for _ in range(10):
+        world.step()
+    assert np.isfinite(body.positions()).all()
