@@ -13,8 +13,11 @@ use tissuesim::Real;
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct GraspOptions {
+    /// Particles within this distance (m) of the tool are held; None: 1.5 particle radii.
     pub reach: Option<Real>,
+    /// Compliance of each attachment (m/N); None: that of the tissue around it.
     pub compliance: Option<Real>,
+    /// Largest total pull (N) before the tissue slips; infinity never slips.
     pub max_force: Real,
 }
 
@@ -60,8 +63,11 @@ impl GraspOptions {
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct NeedleOptions {
+    /// Axial force (N) on the tip that punctures the tissue. Default 1.
     pub puncture_force: Real,
+    /// Axial friction per inserted length (N/m). Default 20.
     pub friction_per_length: Real,
+    /// Hold radius around the shaft (m); None: the needle's radius + 1.5 particle radii.
     pub reach: Option<Real>,
 }
 

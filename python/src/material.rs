@@ -9,8 +9,11 @@ use tissuesim::Real;
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct Material {
+    /// Young's modulus E (Pa), in [1e-6, 1e12]. Default 5000.
     pub youngs_modulus: Real,
+    /// Poisson ratio nu (dimensionless), in [0, 0.49]. Default 0.45.
     pub poisson_ratio: Real,
+    /// Mass density rho (kg/m³), in [1e-6, 1e5]. Default 1060.
     pub density: Real,
 }
 
@@ -63,10 +66,15 @@ impl Material {
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct BodyOptions {
+    /// The material (a copy on read: assign it whole). Default Material().
     pub material: Material,
+    /// Support radius of every particle (m); None chooses one per particle.
     pub support_radius: Option<Real>,
+    /// Target neighbours when the support radius is automatic. Default 20.
     pub target_neighbours: u32,
+    /// Contact radius of the particles (m); None: half the mean edge length.
     pub particle_radius: Option<Real>,
+    /// Variationally consistent MLS gradients. Default True.
     pub consistent_gradients: bool,
 }
 

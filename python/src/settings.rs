@@ -92,23 +92,41 @@ impl DivergenceLimits {
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct Settings {
+    /// Time step of one `World.step` (s). Default 0.001.
     pub dt: Real,
+    /// Gravity acceleration (m/s²), [x, y, z]. Default [0, -9.81, 0].
     pub gravity: [Real; 3],
+    /// Smallest number of substeps per step (>= 1). Default 1.
     pub min_substeps: u32,
+    /// Largest number of substeps per step; a step needing more is clamped. Default 64.
     pub max_substeps: u32,
+    /// Fraction (0, 1] of the explicit stability limit 2/omega_max a substep may use. Default 0.9.
     pub stability_margin: Real,
+    /// Selective mass scaling of particles whose own stable step is too short. Default True.
     pub mass_scaling: bool,
+    /// Mass-proportional damping rate alpha (1/s). Default 2.
     pub damping_mass: Real,
+    /// Stiffness-proportional damping time beta (s). Default 0.
     pub damping_stiffness: Real,
+    /// Hourglass-control stiffness (dimensionless, times the shear modulus). Default 0.25.
     pub hourglass_stiffness: Real,
+    /// XPBD per-tetrahedron volume constraints. Default True.
     pub volume_constraints: bool,
+    /// With volume constraints: lambda carried by them (compliance 1/lambda). Default True.
     pub volumetric_split: bool,
+    /// Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0.
     pub volume_compliance: Real,
+    /// Gauss-Seidel iterations over all constraints per substep. Default 1.
     pub iterations: u32,
+    /// How tool-tissue contact is detected. Default ContactMode.ExactShape.
     pub contact_mode: ContactMode,
+    /// Largest speed (m/s) at which contact removes a penetration already there. Default 1.
     pub max_depenetration_speed: Real,
+    /// Contact between particles of the same body. Default False.
     pub self_contact: bool,
+    /// Threads a step runs on (1..=64); the same bits for any count. Default 1.
     pub threads: u32,
+    /// Physical bounds checked after every step (a copy on read: assign it whole).
     pub divergence: DivergenceLimits,
 }
 

@@ -240,8 +240,11 @@ impl Pose {
 #[pyclass(module = "tissuesim", get_all, set_all, eq, from_py_object)]
 #[derive(Clone, PartialEq, Debug)]
 pub struct ToolOptions {
+    /// Static friction coefficient mu_s (dimensionless). Default 0.
     pub friction_static: Real,
+    /// Kinetic friction coefficient mu_k <= mu_s (dimensionless). Default 0.
     pub friction_kinetic: Real,
+    /// Surface sample spacing (m) of the sampled contact mode; None: particle radius.
     pub sample_spacing: Option<Real>,
 }
 

@@ -81,3 +81,20 @@ def test_world_methods_have_docstrings_and_the_long_ones_say_so():
             assert member.__doc__, f"World.{name} has no docstring"
     assert "GIL released" in tissuesim.World.step.__doc__
     assert "(s)" in tissuesim.World.time.__doc__
+
+
+def test_option_fields_document_their_units_at_run_time():
+    for cls in (
+        tissuesim.Settings,
+        tissuesim.Material,
+        tissuesim.BodyOptions,
+        tissuesim.ToolOptions,
+        tissuesim.GraspOptions,
+        tissuesim.NeedleOptions,
+        tissuesim.DivergenceLimits,
+    ):
+        for name, member in vars(cls).items():
+            if isinstance(member, type(tissuesim.Settings.dt)):
+                assert member.__doc__, f"{cls.__name__}.{name} has no docstring"
+    assert "(s)" in tissuesim.Settings.dt.__doc__
+    assert "(Pa)" in tissuesim.Material.youngs_modulus.__doc__
