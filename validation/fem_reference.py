@@ -132,7 +132,8 @@ DIRECT_ORDERING = 'colamd'  # or 'symmetric-mmd' (validation/mixed_reference.py)
 SYMMETRIC_SOLVER = ('SuperLU in symmetric mode (METIS nested-dissection ordering of A^T + A through pymetis, MMD '
                     'without it; diagonal pivots, diag_pivot_thresh 0), '
                     'up to 3 steps of iterative refinement (while the relative residual is >= 1e-10), falling '
-                    'back to COLAMD with partial pivoting if it is still above 1e-9')
+                    'back to COLAMD with partial pivoting if it is still above 1e-9 and the normwise backward error '
+                    'above 1e-14')
 
 
 def pymetis_version():
@@ -188,10 +189,13 @@ def lu_solve_symmetric(A, b):
     nnz = lu.nnz
     del lu, lu_solve
     # Displacement-only P2 at nu 0.499 stalls near 1e-9 after refinement (COLAMD with partial pivoting gets no
-    # better: 7.8e-10 on the organ c0095), so accept 1e-9 (the checks ask for 1e-8).
-    if res < 1e-9:
-        return x, SYMMETRIC_SOLVER + ': symmetric mode used, ordering %s (nnz(L+U) %d, %d refinement steps)' % (
-            ordering, nnz, steps)
+    # better: 7.8e-10 on the organ c0095, 1.6e-9 on c0068), so accept 1e-9 (the checks ask for 1e-8), or a
+    # normwise backward error ||r|| / (||A||_inf ||x||_inf) below 1e-14 (the solve is then backward stable).
+    backward = np.abs(A @ x - b).max() / (abs(A).sum(axis=1).max() * np.abs(x).max())
+    if res < 1e-9 or backward < 1e-14:
+        return x, SYMMETRIC_SOLVER + (': symmetric mode used, ordering %s (nnz(L+U) %d, %d refinement steps, '
+                                      'relative residual %.1e, backward error %.1e)'
+                                      % (ordering, nnz, steps, res, backward))
     x = spla.spsolve(A, b, permc_spec='COLAMD')
     return x, SYMMETRIC_SOLVER + ': residual %.1e in symmetric mode after %d refinement steps, COLAMD used' % (
         res, steps)

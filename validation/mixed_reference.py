@@ -300,18 +300,17 @@ def print_table(out):
         rank = TABLE_ORDER.index(prefix) if prefix in TABLE_ORDER else len(TABLE_ORDER)
         rows.append((rank, prefix, j))
     print('| mesh | nodes | nu | **P1 vs TH** | P2 vs TH | P1 max nodal error | P2 max nodal error | max \\|u\\| TH '
-          '| P1 / P2 best-fit scale | TH dofs | TH solve [s] | peak RSS [GB] |')
-    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
+          '| P1 / P2 best-fit scale | TH dofs | TH solve [s] |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
     for _, prefix, j in sorted(rows, key=lambda r: r[0]):
         for tag, r in j['results'].items():
             c = r['checks']['th']
             p1, p2 = r['p1_vs_th'], r['p2_vs_th']
-            print('| %s | %s | %g | **%.1f%%** | %.1f%% | %.1f%% | %.1f%% | %.4e | %.2f / %.2f | %s | %.0f | %.1f |'
+            print('| %s | %s | %g | **%.1f%%** | %.1f%% | %.1f%% | %.1f%% | %.4e | %.2f / %.2f | %s | %.0f |'
                   % (prefix, format(j['mesh']['nodes'], ','), r['nu'], 100 * p1['relative_l2'],
                      100 * p2['relative_l2'], 100 * p1['max_nodal_error_over_max_u'],
                      100 * p2['max_nodal_error_over_max_u'], r['th']['max_abs_u'], p1['best_fit_scale_to_ref'],
-                     p2['best_fit_scale_to_ref'], format(c['dofs'], ','), c['solve_s'],
-                     c['process_peak_rss_mb'] / 1024))
+                     p2['best_fit_scale_to_ref'], format(c['dofs'], ','), c['solve_s']))
 
 
 GMSH_MESHES = dict(kidney_gmsh='kidney_gmsh', liver_gmsh='liver_gmsh')
