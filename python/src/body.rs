@@ -3,7 +3,7 @@
 //! Every per-particle array is in the mesh's node order: row k is the mesh's node k, as in the
 //! C API. Index arrays (tetrahedra, boundary triangles) hold node indices.
 
-use crate::arrays::{from_indices, from_vec3s, vec3};
+use crate::arrays::{from_indices, from_vec3s, vec3, vec3s};
 use crate::errors::Check;
 use crate::material::{BodyOptions, Material};
 use crate::mesh::TetMesh;
@@ -34,6 +34,22 @@ fn node_indices<'py, const K: usize>(
         t.iter()
             .map(|t| t.map(|i| order.mesh_index(i as usize) as u32)),
     )
+}
+
+/// Node-order positions (one per particle, finite) in particle order.
+fn particle_positions(b: &tissuesim::Body, x: Vec<Vec3>) -> PyResult<Vec<Vec3>> {
+    let n = b.particle_count();
+    if x.len() != n {
+        return Err(tissuesim::Error::InvalidArgument(format!(
+            "positions: {n} nodes, got {}",
+            x.len()
+        )))
+        .py();
+    }
+    if !x.iter().flatten().all(|c| c.is_finite()) {
+        return Err(tissuesim::Error::NonFinite("positions".into())).py();
+    }
+    Ok(b.particle_order().to_particle_order(&x))
 }
 
 /// A body of a world (a view: every call reads the world's current state).
@@ -170,6 +186,41 @@ impl Body {
             return Err(tissuesim::Error::NonFinite("contains: point".into())).py();
         }
         self.with(py, |b| b.contains(&p))
+    }
+    /// Deformation gradient F (3, 3) of mesh node `k` if the nodes were at `positions` (n, 3),
+    /// m, node order (an analysis helper; the body is not changed).
+    fn deformation_gradient_at<'py>(
+        &self,
+        py: Python<'py>,
+        positions: &Bound<'py, PyAny>,
+        k: usize,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let x = vec3s(positions, "positions")?;
+        let f = self.with(py, |b| -> PyResult<tissuesim::Mat3> {
+            let x = particle_positions(b, x)?;
+            if k >= b.particle_count() {
+                return Err(PyIndexError::new_err(format!("node {k} out of range")));
+            }
+            Ok(b.deformation_gradient_at(&x, b.particle_order().particle(k)))
+        })??;
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| f[(r, c)]).collect())
+            .collect();
+        Ok(PyArray2::from_vec2(py, &rows).expect("3 x 3"))
+    }
+    /// Elastic (and hourglass) forces (n, 3), N, on every node if the nodes were at
+    /// `positions` (n, 3), m, node order, at rest (an analysis helper that allocates).
+    fn elastic_forces_at<'py>(
+        &self,
+        py: Python<'py>,
+        positions: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let x = vec3s(positions, "positions")?;
+        let w = self.world.bind(py).try_borrow()?;
+        let b = w.inner.body(self.id.into()).py()?;
+        let x = particle_positions(b, x)?;
+        let f = py.detach(|| b.elastic_forces_at(&x));
+        Ok(node_order_vec3s(py, b.particle_order(), &f))
     }
     /// Neighbour pairs cut and tetrahedra removed so far.
     fn cut_counts(&self, py: Python<'_>) -> PyResult<(usize, usize)> {

@@ -393,3 +393,20 @@ def test_hostile_inputs_raise_python_errors_never_a_panic():
     for _ in range(10):
         world.step()
     assert np.isfinite(body.positions()).all()
+
+
+def test_deformation_gradients_and_elastic_forces_pass_the_patch_test():
+    world = ts.World()
+    b = world.add_body(ts.mesh.default_organ())
+    body = world.body(b)
+    rest = body.rest_positions()
+    np.testing.assert_allclose(body.elastic_forces_at(rest), 0.0, atol=1e-9)
+    a = np.array([[1.05, 0.02, 0.0], [0.01, 0.97, 0.03], [0.0, -0.02, 1.01]])
+    deformed = rest @ a.T
+    for k in (0, 100, 2242):
+        np.testing.assert_allclose(body.deformation_gradient_at(deformed, k), a, atol=1e-9)
+    forces = body.elastic_forces_at(deformed)
+    assert np.abs(forces).max() > 1e-6, "a stretched body pulls back"
+    np.testing.assert_allclose(forces.sum(axis=0), 0.0, atol=1e-9 * np.abs(forces).max() * 1e3)
+    with pytest.raises(ValueError, match="positions: 2243 nodes, got 3"):
+        body.elastic_forces_at(rest[:3])

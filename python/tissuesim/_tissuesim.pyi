@@ -236,6 +236,12 @@ class Body:
         """Largest angular frequency of the linearised system at rest (rad/s)."""
     def contains(self, point: Vec3Like) -> bool:
         """Whether ``point`` (m) is inside the deformed body."""
+    def deformation_gradient_at(self, positions: ArrayLike, k: int) -> Float2D:
+        """Deformation gradient F (3, 3) of node ``k`` if the nodes were at ``positions``
+        (n, 3), m (an analysis helper)."""
+    def elastic_forces_at(self, positions: ArrayLike) -> Float2D:
+        """Elastic and hourglass forces (n, 3), N, if the nodes were at ``positions`` (n, 3),
+        m, at rest (an analysis helper)."""
     def cut_counts(self) -> tuple[int, int]:
         """(neighbour pairs cut, tetrahedra removed) so far."""
     def model(self) -> BodyModel:
