@@ -218,17 +218,10 @@ pub(crate) fn project_tool_surface(
             let middle_prev = middle(map, &iso_prev, &n0);
             let from_front = (middle_prev - a0).dot(&n0) >= 0.0;
             let motion = (&iso_prev, prev, cur);
-            let Some(contact) = triangle_contact(
-                tool,
-                map,
-                epa,
-                &iso,
-                motion,
-                [a, b, c],
-                &n,
-                from_front,
-                skin,
-            ) else {
+            let start = from_front.then_some(([a0, b0, c0], n0));
+            let Some(contact) =
+                triangle_contact(tool, map, epa, &iso, motion, [a, b, c], &n, start, skin)
+            else {
                 continue;
             };
             let weights = barycentric(&contact.point, &a, &b, &c);
@@ -264,8 +257,7 @@ pub(crate) fn project_tool_surface(
             let relative = moved + normal_shift - tool_motion;
             let shift = normal_shift
                 + friction_correction(&relative, &contact.direction, applied, mu_s, mu_k);
-            let shares: [Real; 3] =
-                std::array::from_fn(|k| (weights[k] * w[k] / denominator).min(MAX_CORNER_SHARE));
+            let shares = corner_shares(&weights, &w);
             // What the cap on the shares keeps the contact point from achieving stays as
             // residual penetration, like the depenetration cap's: not retried in the later passes.
             let achieved: Real = (0..3).map(|k| weights[k] * shares[k]).sum();
@@ -289,6 +281,53 @@ pub(crate) fn project_tool_surface(
     }
 }
 
+/// How far each corner of a triangle moves, in units of a correction of its contact point at
+/// barycentric `weights`, for corner inverse masses `w`: the mass-weighted least-norm shares
+/// `s_k ∝ b_k w_k` with `Σ b_k s_k = 1` (the contact point moves by exactly the correction),
+/// each at most [`MAX_CORNER_SHARE`]. A corner that would move more is held at the cap and the
+/// rest of the correction goes to the others in the same proportion, so that a light corner
+/// beside heavier ones does not leave the contact point short; only when every corner that can
+/// move is at the cap (a contact point next to fixed corners) is `Σ b_k s_k < 1`.
+fn corner_shares(weights: &[Real; 3], w: &[Real; 3]) -> [Real; 3] {
+    let mut shares = [0.0; 3];
+    let mut capped = [false; 3];
+    // What the corners not at the cap must still achieve of the correction.
+    let mut target = 1.0;
+    // Each round caps at least one more corner, or ends.
+    for _ in 0..3 {
+        let denominator: Real = (0..3)
+            .filter(|&k| !capped[k])
+            .map(|k| weights[k] * weights[k] * w[k])
+            .sum();
+        if denominator <= 0.0 {
+            break;
+        }
+        let mut newly_capped = false;
+        for k in 0..3 {
+            if capped[k] {
+                continue;
+            }
+            shares[k] = weights[k] * w[k] / denominator * target;
+            if shares[k] > MAX_CORNER_SHARE {
+                shares[k] = MAX_CORNER_SHARE;
+                capped[k] = true;
+                newly_capped = true;
+            }
+        }
+        if !newly_capped {
+            break;
+        }
+        // A capped corner has b_k < 1/MAX_CORNER_SHARE (its share is at most 1/b_k before the
+        // cap), so what is left to achieve stays positive.
+        target = 1.0
+            - (0..3)
+                .filter(|&k| capped[k])
+                .map(|k| weights[k] * MAX_CORNER_SHARE)
+                .sum::<Real>();
+    }
+    shares
+}
+
 /// A contact of a tool with one boundary triangle.
 struct TriangleContact {
     /// Where it acts on the triangle (m, world frame).
@@ -301,7 +340,8 @@ struct TriangleContact {
 
 /// The contact of the tool (`map` at `iso`; `motion`: at `iso_prev`, the poses at the substep's
 /// start and end) with the triangle `corners` (outward unit normal `n`) within `skin` (m),
-/// one-sided as the module describes; `from_front`: whether the tool came from in front of it.
+/// one-sided as the module describes; `start`: when the tool came from in front of it, the
+/// triangle's corners and unit normal at the substep's start.
 #[allow(clippy::too_many_arguments)]
 fn triangle_contact(
     tool: &Tool,
@@ -311,7 +351,7 @@ fn triangle_contact(
     (iso_prev, prev, cur): (&Isometry<Real>, &Pose, &Pose),
     corners: [Vec3; 3],
     n: &Vec3,
-    from_front: bool,
+    start: Option<([Vec3; 3], Vec3)>,
     skin: Real,
 ) -> Option<TriangleContact> {
     let [a, b, c] = corners;
@@ -340,7 +380,7 @@ fn triangle_contact(
             on_triangle,
             axis,
         } => {
-            if from_front && axis.dot(n) > 0.0 && height(&middle(map, iso, n)) < 0.0 {
+            if start.is_some() && axis.dot(n) > 0.0 && height(&middle(map, iso, n)) < 0.0 {
                 // The tool came from in front and its middle is now behind the plane: separating
                 // this way would put the triangle in front of it; the tool went through it.
                 return in_front();
@@ -351,23 +391,30 @@ fn triangle_contact(
                 depth: skin - (on_triangle - on_tool).dot(&axis),
             })
         }
-        Separation::Apart if from_front => {
-            // Swept: the tool's middle crossed the plane within the substep, and the tool
-            // touched the triangle at that instant.
+        Separation::Apart => {
+            // Swept: the tool's middle crossed the triangle's plane within the substep relative
+            // to the triangle (the tool moved, or the passes before this one moved the
+            // triangle past it), and the tool touched the triangle at that instant. Heights and
+            // corners are taken as linear in the substep's fraction between start and end.
+            let ([a0, b0, c0], n0) = start?;
             let (h0, h1) = (
-                height(&middle(map, iso_prev, n)),
+                (middle(map, iso_prev, &n0) - a0).dot(&n0),
                 height(&middle(map, iso, n)),
             );
             if h1 >= 0.0 || h0 < 0.0 {
                 return None;
             }
-            let crossing = Pose::interpolate(prev, cur, h0 / (h0 - h1)).isometry();
-            match separation(tool, map, epa, &crossing, &triangle, n, skin) {
+            let s = h0 / (h0 - h1);
+            let [sa, sb, sc] = [(a0, a), (b0, b), (c0, c)].map(|(q0, q)| q0 + (q - q0) * s);
+            let n_s = (sb - sa).cross(&(sc - sa)).try_normalize(0.0)?;
+            let triangle_s = Triangle::new(Point::from(sa), Point::from(sb), Point::from(sc));
+            let crossing = Pose::interpolate(prev, cur, s).isometry();
+            match separation(tool, map, epa, &crossing, &triangle_s, &n_s, skin) {
                 Separation::Apart => None,
                 _ => in_front(),
             }
         }
-        _ => None,
+        Separation::Unknown => None,
     }
 }
 

@@ -1,0 +1,192 @@
+//! Deep presses against the organ's surface, measured geometrically: spheres of 1 to 10 mm
+//! pressed 3 cm past first contact into the hanging default organ from four sides at 5 cm/s,
+//! held for 0.5 s and withdrawn. After every step the probe's centre is checked against the
+//! deformed boundary surface (generalised winding number) and the surface's depth inside the
+//! probe is measured as the radius less the distance from the centre to the nearest boundary
+//! triangle: what a trainer sees, not what the library reports.
+
+mod common;
+
+use parry3d_f64::math::Point;
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
+use std::sync::Arc;
+use tissuesim::{
+    mesh, Body, BodyModel, BodyOptions, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+    WorldState,
+};
+
+/// How far past first contact the probe is pressed (m).
+const PRESS: Real = 0.03;
+/// Press and withdrawal speed (m/s).
+const SPEED: Real = 0.05;
+/// How long the probe is held at full depth (s).
+const HOLD: Real = 0.5;
+/// The most of a probe's radius the surface may get inside it (the contact goal).
+const MOST_INSIDE: Real = 0.2;
+
+/// The settled hanging organ: its shared model, its positions, and the state of a world
+/// holding it alone. The state carries what a press continues from (positions, velocities,
+/// the particles' rotations).
+struct Hanging {
+    model: Arc<BodyModel>,
+    rest: Vec<Vec3>,
+    positions: Vec<Vec3>,
+    state: WorldState,
+}
+
+fn hanging_organ() -> Hanging {
+    let mut world = World::new(Settings::default()).unwrap();
+    let body = world
+        .add_body(&mesh::default_organ(), &BodyOptions::default())
+        .unwrap();
+    common::fix_top(&mut world, body, 0.15);
+    world.settle().unwrap();
+    let b = world.body(body).unwrap();
+    Hanging {
+        model: b.model().clone(),
+        rest: b.rest_positions().to_vec(),
+        positions: b.positions().to_vec(),
+        state: world.state(),
+    }
+}
+
+/// What one press measured.
+#[derive(Debug)]
+struct Press {
+    /// Largest depth of the surface inside the probe over the whole press (m; ≤ 0 apart).
+    deepest: Real,
+    /// Steps on which the probe's centre was inside the deformed surface.
+    centre_inside: usize,
+    /// Steps of the press and hold in contact whose force pulled the probe in.
+    pulling: usize,
+    /// Steps of the press and hold in contact.
+    contact_steps: usize,
+}
+
+/// Depth (m) of the body's boundary surface inside a sphere at `centre` of `radius`: the
+/// radius less the distance to the nearest boundary triangle.
+fn surface_depth(body: &Body, centre: &Vec3, radius: Real) -> Real {
+    let x = body.positions();
+    let c = Point::from(*centre);
+    let nearest = body
+        .boundary_triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, d] = t.map(|k| Point::from(x[k as usize]));
+            Triangle::new(a, b, d).distance_to_local_point(&c, true)
+        })
+        .fold(Real::INFINITY, Real::min);
+    radius - nearest
+}
+
+/// Press a sphere of `radius` (m) along the horizontal unit `direction` on the line through
+/// `through` (m), from 2 mm off the contact skin, [`PRESS`] past it, hold, withdraw.
+fn press(organ: &Hanging, radius: Real, direction: Vec3, through: Vec3) -> Press {
+    let mut world = World::new(Settings::default()).unwrap();
+    let body = world.add_body_model(organ.model.clone());
+    world.set_state(&organ.state).unwrap();
+    let near_line = |p: &&Vec3| {
+        let q = *p - through;
+        (q - direction * q.dot(&direction)).norm() < 0.01
+    };
+    let surface = organ
+        .positions
+        .iter()
+        .filter(near_line)
+        .map(|p| (p - through).dot(&direction))
+        .fold(Real::INFINITY, Real::min);
+    assert!(surface.is_finite(), "no particle on the press line");
+    let gap = 0.002;
+    let skin = world.body(body).unwrap().contact_skin();
+    let start = through + direction * (surface - skin - gap - radius);
+    let probe = ToolShape::Sphere { radius };
+    let tool = world
+        .add_tool(probe, Pose::at(start), &ToolOptions::default())
+        .unwrap();
+    let dt = world.settings().dt;
+    let press_steps = ((gap + PRESS) / SPEED / dt).round() as usize;
+    let hold_steps = (HOLD / dt).round() as usize;
+    let total = 2 * press_steps + hold_steps;
+    let mut result = Press {
+        deepest: Real::NEG_INFINITY,
+        centre_inside: 0,
+        pulling: 0,
+        contact_steps: 0,
+    };
+    for k in 1..=total {
+        let along = k.min(press_steps).min(total - k) as Real;
+        let centre = start + direction * (SPEED * dt * along);
+        world.set_tool_pose(tool, Pose::at(centre)).unwrap();
+        world.step().unwrap();
+        result.deepest =
+            result
+                .deepest
+                .max(surface_depth(world.body(body).unwrap(), &centre, radius));
+        result.centre_inside += world.body(body).unwrap().contains(&centre) as usize;
+        let wrench = world.tool(tool).unwrap().wrench();
+        if wrench.contact_count > 0 && k <= press_steps + hold_steps {
+            result.contact_steps += 1;
+            result.pulling += (wrench.force.dot(&direction) > 0.0) as usize;
+        }
+    }
+    result
+}
+
+/// The four horizontal presses through the middle of the organ's rest bounding box: along ±x
+/// and ±z.
+fn sides(organ: &Hanging) -> [(&'static str, Vec3, Vec3); 4] {
+    let (lo, hi) = common::bounds(&organ.rest);
+    let middle = (lo + hi) * 0.5;
+    let across_x = Vec3::new(0.0, middle.y, middle.z);
+    let across_z = Vec3::new(middle.x, middle.y, 0.0);
+    [
+        ("+x", Vec3::x(), across_x),
+        ("-x", -Vec3::x(), across_x),
+        ("+z", Vec3::z(), across_z),
+        ("-z", -Vec3::z(), across_z),
+    ]
+}
+
+/// Every press of every sphere of `radii` (m) from every side; panics listing those for which
+/// `fails` holds, under the heading `goal`.
+fn check(radii: &[Real], goal: &str, fails: impl Fn(Real, &Press) -> bool) {
+    let organ = hanging_organ();
+    let mut failures = Vec::new();
+    for &radius in radii {
+        for (side, direction, through) in sides(&organ) {
+            let p = press(&organ, radius, direction, through);
+            let what = format!("r = {} mm, pressed along {side}: {p:?}", radius * 1e3);
+            assert!(p.contact_steps > 500, "{what}: the probe barely touched");
+            if fails(radius, &p) {
+                failures.push(what);
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{goal}:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn spheres_of_1_to_10_mm_pressed_3_cm_from_four_sides_never_pop_in() {
+    check(
+        &[0.001, 0.0025, 0.005, 0.010],
+        "the probe's centre inside the organ",
+        |_, p| p.centre_inside > 0,
+    );
+}
+
+/// Open, measured with this test: the surface got 92% of the radius inside the 1 mm probe
+/// pressed along −x (its centre outside), and one contact step of the 1 mm probe along +z
+/// pulled it in (−0.05 N amid +0.2 N). Where a small probe's funnel wraps triangles several
+/// times its size round it, the depenetration cap's first-order estimate of the penetration
+/// already there counts the triangles' own last correction as old, and what the cap holds back
+/// stays inside; two iterations per substep hold these presses.
+#[test]
+#[ignore = "open: the surface gets more than a fifth of the radius inside a 1 mm probe"]
+fn deep_presses_keep_the_surface_within_a_fifth_of_the_radius_and_push_back() {
+    check(
+        &[0.001, 0.0025, 0.005, 0.010],
+        "surface more than a fifth of the radius inside the probe, or the force pulling it in",
+        |radius, p| p.deepest > MOST_INSIDE * radius || p.pulling > 0,
+    );
+}
