@@ -157,6 +157,7 @@ fn check(radii: &[Real], goal: &str, fails: impl Fn(Real, &Press) -> bool) {
         for (side, direction, through) in sides(&organ) {
             let p = press(&organ, radius, direction, through);
             let what = format!("r = {} mm, pressed along {side}: {p:?}", radius * 1e3);
+            eprintln!("{what}");
             assert!(p.contact_steps > 500, "{what}: the probe barely touched");
             if fails(radius, &p) {
                 failures.push(what);
