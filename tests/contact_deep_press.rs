@@ -86,20 +86,10 @@ fn press(organ: &Hanging, radius: Real, direction: Vec3, through: Vec3) -> Press
     let mut world = World::new(Settings::default()).unwrap();
     let body = world.add_body_model(organ.model.clone());
     world.set_state(&organ.state).unwrap();
-    let near_line = |p: &&Vec3| {
-        let q = *p - through;
-        (q - direction * q.dot(&direction)).norm() < 0.01
-    };
-    let surface = organ
-        .positions
-        .iter()
-        .filter(near_line)
-        .map(|p| (p - through).dot(&direction))
-        .fold(Real::INFINITY, Real::min);
-    assert!(surface.is_finite(), "no particle on the press line");
     let gap = 0.002;
     let skin = world.body(body).unwrap().contact_skin();
-    let start = through + direction * (surface - skin - gap - radius);
+    let line = (through, direction);
+    let start = common::press_start(&organ.positions, skin, line, radius, gap);
     let probe = ToolShape::Sphere { radius };
     let tool = world
         .add_tool(probe, Pose::at(start), &ToolOptions::default())

@@ -38,23 +38,11 @@ fn hanging_organ() -> (World, BodyId) {
 /// [`PRESS`] past it.
 fn press(radius: Real, direction: Vec3, through: Vec3, speed: Real) -> Press {
     let (mut world, body) = hanging_organ();
-    let near_line = |p: &&Vec3| {
-        let q = *p - through;
-        (q - direction * q.dot(&direction)).norm() < 0.01
-    };
-    let surface = world
-        .body(body)
-        .unwrap()
-        .positions()
-        .iter()
-        .filter(near_line)
-        .map(|p| (p - through).dot(&direction))
-        .fold(Real::INFINITY, Real::min);
-    assert!(surface.is_finite(), "no particle on the press line");
     // Start 2 mm clear of the contact skin over the surface; depth counts from the skin.
     let gap = 0.002;
-    let skin = world.body(body).unwrap().contact_skin();
-    let start = through + direction * (surface - skin - gap - radius);
+    let b = world.body(body).unwrap();
+    let line = (through, direction);
+    let start = common::press_start(b.positions(), b.contact_skin(), line, radius, gap);
     let tool = world
         .add_tool(
             ToolShape::Sphere { radius },

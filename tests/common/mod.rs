@@ -119,6 +119,26 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
+/// Where a press along the unit `direction` on the line through `through` (m) starts: the
+/// centre (m) of a sphere of `radius` (m) `gap` (m) clear of the contact skin over the first
+/// particle within 1 cm of the line. Panics when no particle is that near the line.
+pub fn press_start(
+    positions: &[Vec3],
+    skin: Real,
+    (through, direction): (Vec3, Vec3),
+    radius: Real,
+    gap: Real,
+) -> Vec3 {
+    let surface = positions
+        .iter()
+        .map(|p| p - through)
+        .filter(|q| (q - direction * q.dot(&direction)).norm() < 0.01)
+        .map(|q| q.dot(&direction))
+        .fold(Real::INFINITY, Real::min);
+    assert!(surface.is_finite(), "no particle on the press line");
+    through + direction * (surface - skin - gap - radius)
+}
+
 /// Largest distance between `x` and the rigid motion of `rest` that best fits it (Kabsch,
 /// weights `w`): the deformation left once translation and rotation are removed (m).
 pub fn max_residual_after_rigid_fit(rest: &[Vec3], x: &[Vec3], w: &[Real]) -> Real {
