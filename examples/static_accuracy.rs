@@ -4,13 +4,16 @@
 //!
 //! ```text
 //! cargo run --release --example static_accuracy -- [--neighbours K] [--hourglass C]
-//!     [--nodal-volume] [--plain-mls] [--audit] [SCENE ...]
+//!     [--nodal-volume] [--plain-mls] [--audit] [--nu 0.3,0.45,...] [SCENE ...]
 //! ```
+//! The reference is P2 (displacement) below ν 0.45 and Taylor–Hood (mixed P2/P1,
+//! `*_th.csv`) from 0.45 up, where displacement-only P2 locks too (validation/README.md g).
 //! `--audit` adds, per scene, the solution's best-fit scale against P2 (> 1: too soft) and the
 //! energy audit of `audit.rs`: the deviatoric energy of the P2 field as the particles see it,
 //! over what linear tetrahedra see, for the surface, interior and fixed particles.
-//! Scenes: `liver_1k6`, `liver_4k`, `liver_10k` (ν 0.3 and 0.45 each), `organ_c0133`,
-//! `organ_c0095`, `organ_c0068`, `cantilever` (ν 0.3, and 0.45 when its reference exists).
+//! Scenes: `liver_1k6`, `liver_4k`, `liver_10k`, `organ_c0133`, `organ_c0095`, `organ_c0068`,
+//! `kidney_gmsh`, `liver_gmsh` (at each ν of `--nu`, default 0.3 and 0.45), `cantilever`
+//! (ν 0.3, and 0.45 when its reference exists).
 //! A scene whose reference file is missing is reported and skipped.
 
 #[path = "static_accuracy/audit.rs"]
@@ -82,12 +85,19 @@ fn liver_material(nu: Real) -> Material {
     }
 }
 
-fn scenes(names: &[String]) -> Res<Vec<Scene>> {
+/// The reference files' tag of a Poisson ratio: `nu030`, `nu045`, `nu049`, `nu0499`.
+fn nu_tag(nu: Real) -> String {
+    let digits = format!("{nu}");
+    let fraction = digits.trim_start_matches("0.");
+    format!("nu0{fraction:0<2}")
+}
+
+fn scenes(names: &[String], ratios: &[Real]) -> Res<Vec<Scene>> {
     let refdir = repo().join("validation/reference");
     let mut out = Vec::new();
     for name in names {
-        for nu in [0.3, 0.45] {
-            let tag = if nu == 0.3 { "nu030" } else { "nu045" };
+        for &nu in ratios {
+            let tag = nu_tag(nu);
             let (mesh, prefix) = if let Some(rest) = name.strip_prefix("organ_c") {
                 let cell: Real = format!("0.{rest}").parse()?;
                 let mut m = mesh::organ_with_cell(cell);
@@ -105,6 +115,9 @@ fn scenes(names: &[String]) -> Res<Vec<Scene>> {
                     "cantilever_nu045".to_string()
                 };
                 (m, prefix)
+            } else if name.ends_with("_gmsh") {
+                let m = mesh::load(&mesh_dir().join(format!("{name}.node")), 1.0)?.0;
+                (m, format!("{name}_{tag}"))
             } else {
                 let m = mesh::load(&mesh_dir().join(format!("{name}.node")), 1.0)?.0;
                 (m, format!("{}_{tag}", name.replace('_', "")))
@@ -113,6 +126,12 @@ fn scenes(names: &[String]) -> Res<Vec<Scene>> {
                 (
                     refdir.join(format!("{prefix}_p2_lattice.csv")),
                     refdir.join(format!("{prefix}_p1_lattice.csv")),
+                )
+            } else if nu >= 0.45 {
+                // Taylor–Hood (mixed P2/P1) from ν 0.45 up: displacement-only P2 locks there.
+                (
+                    refdir.join(format!("{prefix}_th.csv")),
+                    refdir.join(format!("{prefix}_p1.csv")),
                 )
             } else {
                 (
@@ -197,8 +216,16 @@ fn main() -> Res<()> {
     let mut settings = Settings::default();
     let mut names = Vec::new();
     let mut with_audit = false;
+    let mut ratios = vec![0.3, 0.45];
     while let Some(a) = args.next() {
         match a.as_str() {
+            "--nu" => {
+                let list = args.next().ok_or("--nu needs a list, e.g. 0.45,0.49")?;
+                ratios = list
+                    .split(',')
+                    .map(|v| v.trim().parse())
+                    .collect::<Result<_, _>>()?;
+            }
             "--neighbours" => options.target_neighbours = args.next().ok_or("K")?.parse()?,
             "--hourglass" => settings.hourglass_stiffness = args.next().ok_or("C")?.parse()?,
             "--nodal-volume" => settings.volume_constraints = false,
@@ -213,8 +240,8 @@ fn main() -> Res<()> {
             .map(String::from)
             .to_vec();
     }
-    println!("scene | point-based vs P2 | P1 vs P2");
-    for scene in scenes(&names)? {
+    println!("scene | point-based vs reference | P1 vs reference");
+    for scene in scenes(&names, &ratios)? {
         let Ok(reference) = read_reference(&scene.reference) else {
             println!(
                 "{} | no reference ({})",
