@@ -17,7 +17,7 @@ use std::sync::Arc;
 
 /// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
 /// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along
-/// and compressed tissue springs back (measured in `tests/issue_robustness.rs`, friction 1,
+/// and compressed tissue springs back (measured in `tests/api_robustness.rs`, friction 1,
 /// random sweeps at up to 12 m/s inside the default organ: tissue at up to 42 m/s, 3.5×), so
 /// the tool must stay well below the bound for the tissue to stay within it.
 pub const TOOL_JUMP_FRACTION: Real = 0.25;

@@ -1,4 +1,4 @@
-//! The C API functions that cover the rest of the Rust API a trainer uses (issue 9 item 4),
+//! The C API functions that cover the rest of the Rust API a trainer uses,
 //! checked by their physical effect through the `extern "C"` functions: setting a body's
 //! positions and velocities, reading its fixed flags and particle radius, removing a tool,
 //! convex-hull and triangle-array tools, tool friction, body-pair friction. And the one

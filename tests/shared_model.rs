@@ -1,4 +1,4 @@
-//! The body model is immutable and shareable (the architecture issue, item 1): worlds built on
+//! The body model is immutable and shareable: worlds built on
 //! one `Arc<BodyModel>` hold the same load-time data without copying it, step exactly as
 //! worlds that loaded the mesh themselves, and a cut in one world leaves the others' model
 //! untouched (copy-on-write).

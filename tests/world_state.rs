@@ -1,4 +1,4 @@
-//! The world state as one value (the architecture issue, item 1): `World::state` /
+//! The world state as one value: `World::state` /
 //! `World::set_state`, its byte form, the fixed flags in it, and the rollback of a diverged
 //! step putting back all of it (particles, needle holds, grasps), not only the particles.
 

@@ -1,4 +1,4 @@
-//! Cutting (the surgical-interaction issue, item 4): a blade's swept edge removes the neighbour
+//! Cutting: a blade's swept edge removes the neighbour
 //! pairs and tetrahedra it crosses. A piece cut free falls and keeps its volume; a partial cut
 //! in the stretched side of a sagging cantilever opens; cuts are deterministic and survive
 //! save/restore.

@@ -1,4 +1,4 @@
-//! Contact against the organ's surface (the surgical-interaction issue, item 1): instruments
+//! Contact against the organ's surface: instruments
 //! thinner than the particle spacing press the deformed boundary triangles, not only the
 //! particles, so that they never pass into the tissue. Scene: the default organ hanging from its
 //! top 15%, settled at rest, a sphere pressed horizontally into it.

@@ -1,4 +1,4 @@
-//! Needle insertion (the surgical-interaction issue, item 3): the axial force on a needle
+//! Needle insertion: the axial force on a needle
 //! pushed into tissue rises while the tip indents the surface, drops when it punctures at the
 //! puncture force, then grows with the inserted length through the shaft's friction; pulling it
 //! back out releases the tissue.

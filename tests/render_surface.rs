@@ -1,4 +1,4 @@
-//! Issue 9 item 5: the render surface. A visual OBJ (liver-smooth.obj) bound to the
+//! The render surface: a visual OBJ (liver-smooth.obj) bound to the
 //! simulation mesh (liver.msh, same frame) follows the particles: an affine motion of the
 //! particles moves every bound vertex, inside or outside the tetrahedra, by exactly that map;
 //! normals rotate with a rotation; the binding finds the enclosing (or nearest) tetrahedron;
@@ -35,7 +35,7 @@ fn move_affinely(world: &mut World, body: BodyId, a: &Mat3, b: &Vec3) {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("issue_render_surface");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render_surface");
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }

@@ -1,4 +1,4 @@
-//! Grasping (the surgical-interaction issue, item 2): a tool attaches the tissue within its
+//! Grasping: a tool attaches the tissue within its
 //! jaws, lifts it with the reaction force on the tool equal to the weight of what it holds,
 //! lets go on release, and lets the tissue slip beyond a holding force.
 
