@@ -1,4 +1,4 @@
-//! Diagnostic for docs/VALIDATION.md §1.4: the gravity sag of the project's own quasi-uniform
+//! Diagnostic for docs/history/VALIDATION_HISTORY.md §1.4: the gravity sag of the project's own quasi-uniform
 //! default organ (scaled ×30 to liver size, mesh units), the liver scene's material (E 3000,
 //! ν 0.3, ρ 1, g 0.981, top 10% fixed), compared with scikit-fem by `validation/organ_check.sh`.
 //!
