@@ -54,8 +54,9 @@ pub(crate) const MAX_SURFACE_PASSES: usize = 8;
 /// constraint moves corner `k` by `b_k w_k / Σ b_j² w_j` times the correction (`b` barycentric
 /// weights, `w` inverse masses): at most ~1.4 for equal masses, but without bound when the
 /// contact point sits next to a fixed corner (the free corner, at a tiny `b`, would be flung by
-/// `1/b`; the soak run saw particles at 1e13 m/s). What the cap keeps the contact point from
-/// achieving stays as residual penetration, like the depenetration cap's.
+/// `1/b`; the soak run saw particles at 1e13 m/s). A capped corner's excess goes to the other
+/// corners ([`corner_shares`]); what no corner can take stays as residual penetration, like the
+/// depenetration cap's.
 pub(crate) const MAX_CORNER_SHARE: Real = 2.0;
 
 /// The passes stop when the largest correction of a pass is below this fraction of the skin.
