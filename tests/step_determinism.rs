@@ -3,8 +3,7 @@
 
 mod common;
 
-use common::{fix_top, liver, tissue};
-use tissuesim::mesh::default_organ;
+use common::{fix_top, two_bodies_stacked};
 use tissuesim::{Pose, Settings, ToolOptions, ToolShape, Vec3, World};
 
 fn scene() -> World {
@@ -16,14 +15,7 @@ fn scene_with_threads(threads: u32) -> World {
         threads,
         ..Settings::default()
     };
-    let mut world = World::new(settings).unwrap();
-    let a = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
-    fix_top(&mut world, a, 0.1);
-    let mut organ = default_organ();
-    for p in &mut organ.nodes {
-        *p += Vec3::new(0.0, -0.13, 0.0);
-    }
-    let b = world.add_body(&organ, &tissue()).unwrap();
+    let (mut world, a, b) = two_bodies_stacked(settings);
     fix_top(&mut world, b, 0.05);
     world.set_body_pair_friction(a, b, 0.4, 0.3).unwrap();
     let options = ToolOptions {

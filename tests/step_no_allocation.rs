@@ -4,11 +4,10 @@
 
 mod common;
 
-use common::{fix_top, liver, tissue};
+use common::two_bodies_stacked;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use tissuesim::mesh::default_organ;
-use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3, World};
+use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3};
 
 struct Counting;
 
@@ -56,14 +55,7 @@ fn steps_after_the_first_do_not_allocate() {
             threads,
             ..Settings::default()
         };
-        let mut world = World::new(settings).unwrap();
-        let a = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
-        fix_top(&mut world, a, 0.1);
-        let mut organ = default_organ();
-        for p in &mut organ.nodes {
-            *p += Vec3::new(0.0, -0.13, 0.0);
-        }
-        let b = world.add_body(&organ, &tissue()).unwrap();
+        let (mut world, a, b) = two_bodies_stacked(settings);
         world.set_body_pair_friction(a, b, 0.3, 0.2).unwrap();
         let options = ToolOptions {
             friction_static: 0.5,

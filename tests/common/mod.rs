@@ -119,6 +119,21 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
+/// A world with `settings` and two bodies, one above the other so that they touch as they sag:
+/// liver_1k6 (its top 10% fixed) and below it the default organ moved 13 cm down (nothing fixed).
+/// Returns the world and the two bodies' ids, upper first.
+pub fn two_bodies_stacked(settings: Settings) -> (World, BodyId, BodyId) {
+    let mut world = World::new(settings).unwrap();
+    let a = world.add_body(&liver("liver_1k6.node"), &tissue()).unwrap();
+    fix_top(&mut world, a, 0.1);
+    let mut organ = mesh::default_organ();
+    for p in &mut organ.nodes {
+        *p += Vec3::new(0.0, -0.13, 0.0);
+    }
+    let b = world.add_body(&organ, &tissue()).unwrap();
+    (world, a, b)
+}
+
 /// Where a press along the unit `direction` on the line through `through` (m) starts: the
 /// centre (m) of a sphere of `radius` (m) `gap` (m) clear of the contact skin over the first
 /// particle within 1 cm of the line. Panics when no particle is that near the line.
