@@ -49,6 +49,21 @@ fn sagging_liver_keeps_its_volume_within_one_percent() {
     );
 }
 
+/// At the largest accepted Poisson ratio (ν = 0.499, λ/μ = 499) the default solver steps an
+/// organ stably and keeps its volume closer than at 0.49: the volume constraints carry λ
+/// implicitly, so no explicit bulk stiffness limits the step.
+#[test]
+fn nearly_incompressible_0499_liver_sags_and_keeps_its_volume() {
+    let at_0499 = worst_volume_error(true, tissuesim::MAX_POISSON_RATIO);
+    let at_049 = worst_volume_error(true, 0.49);
+    assert!(
+        at_0499 < 0.005 && at_0499 < at_049,
+        "volume error {:.3}% at nu 0.499 against {:.3}% at 0.49",
+        at_0499 * 100.0,
+        at_049 * 100.0
+    );
+}
+
 #[test]
 fn default_particles_hold_the_volume_of_a_nu_045_organ_like_the_constraints() {
     let particles = worst_volume_error(false, 0.45);

@@ -123,7 +123,7 @@ crate::fmi2_variables! {
         MAX_DISPLACEMENT = output("max_displacement", "m", "Largest distance of an organ particle from its rest position at the end of the step"),
         MAX_PENETRATION = output("max_penetration", "m", "Largest contact violation before projection (how far the surface was inside the tool's contact skin), last internal step"),
         YOUNGS_MODULUS = param("youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
-        POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::MIN_POISSON_RATIO), Some(tissuesim::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.49] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
+        POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::MIN_POISSON_RATIO), Some(tissuesim::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.499] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
         DENSITY = param("density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
         DAMPING = param("damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
         FRICTION_STATIC = param("friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),

@@ -11,7 +11,7 @@ use tissuesim::Real;
 pub struct Material {
     /// Young's modulus E (Pa), in [1e-6, 1e12]. Default 5000.
     pub youngs_modulus: Real,
-    /// Poisson ratio nu (dimensionless), in [0, 0.49]. Default 0.45.
+    /// Poisson ratio nu (dimensionless), in [0, 0.499]. Default 0.45.
     pub poisson_ratio: Real,
     /// Mass density rho (kg/m³), in [1e-6, 1e5]. Default 1060.
     pub density: Real,

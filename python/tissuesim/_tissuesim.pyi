@@ -18,7 +18,7 @@ __version__: Final[str]
 MIN_POISSON_RATIO: Final[float]
 """Smallest Poisson ratio a body accepts (0)."""
 MAX_POISSON_RATIO: Final[float]
-"""Largest Poisson ratio a body accepts (0.49)."""
+"""Largest Poisson ratio a body accepts (0.499)."""
 YOUNGS_MODULUS_RANGE: Final[tuple[float, float]]
 """Accepted Young's moduli (Pa)."""
 DENSITY_RANGE: Final[tuple[float, float]]
@@ -148,7 +148,7 @@ class Material:
     youngs_modulus: float
     """Young's modulus E (Pa), in [1e-6, 1e12]. Default 5000."""
     poisson_ratio: float
-    """Poisson ratio ν (dimensionless), in [0, 0.49]. Default 0.45."""
+    """Poisson ratio ν (dimensionless), in [0, 0.499]. Default 0.45."""
     density: float
     """Mass density ρ (kg/m³), in [1e-6, 1e5]. Default 1060."""
     def __init__(
