@@ -98,7 +98,9 @@ typedef enum ts_status {
      */
     TS_STATUS_BAD_STATE = 8,
     /**
-     * The step produced NaN/Inf; the world was rolled back to its state before the step.
+     * The step produced NaN/Inf or left the divergence limits of ts_settings (particle speed,
+     * body extent, volume ratio); the world was rolled back to its state before the step and
+     * the message names the body and the reason.
      */
     TS_STATUS_DIVERGED = 9,
     /**
@@ -124,11 +126,14 @@ typedef enum ts_status {
  */
 typedef enum ts_contact_mode {
     /**
-     * Exact distance from each particle to the tool's shape (the default): a smooth force.
+     * The tool's exact shape against the body's deformed boundary triangles (the default):
+     * contact starts a skin of a tenth of the particle radius out from the surface, one-sided
+     * and swept, so tools thinner than the particle spacing do not slip in.
      */
     TS_CONTACT_MODE_EXACT_SHAPE = 0,
     /**
-     * The paper's mode: the tool surface sampled into points, particles pushed out of them.
+     * The paper's mode: the tool surface sampled into points, particles (spheres of the
+     * particle radius) pushed out of them; thin tools can slip between particles.
      */
     TS_CONTACT_MODE_SAMPLED_POINTS = 1,
 } ts_contact_mode;
@@ -290,8 +295,10 @@ typedef struct ts_body_options {
      */
     double support_radius;
     /**
-     * Contact radius of the particles (m); 0 derives it from the particle spacing (half the
-     * mean edge length). Otherwise in [0.05, 2] x the mesh's mean edge length.
+     * Contact radius of the particles (m) for organ-organ contact and the sampled-points tool
+     * contact (the exact-shape tool contact's skin is a tenth of it); 0 derives it from the
+     * particle spacing (half the mean edge length). Otherwise in [0.05, 2] x the mesh's mean
+     * edge length.
      */
     double particle_radius;
     /**
@@ -531,9 +538,11 @@ enum ts_status ts_world_set_settings(struct ts_world *world, const struct ts_set
 
 /**
  * Advance the world by settings.dt (substepping as stability requires). On
- * TS_STATUS_DIVERGED the step produced NaN/Inf and the world was rolled back to its state
- * before the call. `out_report` is optional (may be NULL); it is written on success only.
- * Allocates nothing after the first step.
+ * TS_STATUS_DIVERGED the step produced NaN/Inf or left the divergence limits of ts_settings
+ * (particle speed, body extent, volume ratio) and the world was rolled back to its state
+ * before the call (time not advanced; the message names the body and the reason).
+ * `out_report` is optional (may be NULL); it is written on success only. Allocates nothing
+ * after the first step, except in a step in which a blade tool cuts.
  *
  * # Safety
  *
@@ -597,7 +606,8 @@ enum ts_status ts_world_body_count(const struct ts_world *world, uint32_t *out_c
 enum ts_status ts_world_tool_count(const struct ts_world *world, uint32_t *out_count);
 
 /**
- * Number of steps so far that produced NaN/Inf and were rolled back (TS_STATUS_DIVERGED).
+ * Number of steps so far that diverged (NaN/Inf or outside the divergence limits) and were
+ * rolled back (TS_STATUS_DIVERGED).
  *
  * # Safety
  *
@@ -920,8 +930,11 @@ enum ts_status ts_body_fixed_flags(const struct ts_world *world,
                                    size_t len);
 
 /**
- * Contact radius of the body's particles (m) into *out_radius: a particle touches a tool
- * when its centre comes closer than this to the tool's surface.
+ * Contact radius of the body's particles (m) into *out_radius: particles of different bodies
+ * are kept r_a + r_b apart, and in TS_CONTACT_MODE_SAMPLED_POINTS a particle touches a tool
+ * when its centre comes closer than this to the tool's samples. In the default
+ * TS_CONTACT_MODE_EXACT_SHAPE tools touch the boundary triangles, with a skin of a tenth of
+ * this radius.
  *
  * # Safety
  *

@@ -38,8 +38,10 @@ pub struct ts_body_options {
     /// Support radius of every particle (m); 0 chooses one per particle automatically.
     /// Otherwise in [0.5, 3] x the mesh's mean edge length (and at most 384 neighbours).
     pub support_radius: f64,
-    /// Contact radius of the particles (m); 0 derives it from the particle spacing (half the
-    /// mean edge length). Otherwise in [0.05, 2] x the mesh's mean edge length.
+    /// Contact radius of the particles (m) for organ-organ contact and the sampled-points tool
+    /// contact (the exact-shape tool contact's skin is a tenth of it); 0 derives it from the
+    /// particle spacing (half the mean edge length). Otherwise in [0.05, 2] x the mesh's mean
+    /// edge length.
     pub particle_radius: f64,
     /// Target number of neighbours when the support radius is automatic (1..=96).
     pub target_neighbours: u32,
@@ -883,8 +885,11 @@ pub unsafe extern "C" fn ts_body_fixed_flags(
     }
 }
 
-/// Contact radius of the body's particles (m) into *out_radius: a particle touches a tool
-/// when its centre comes closer than this to the tool's surface.
+/// Contact radius of the body's particles (m) into *out_radius: particles of different bodies
+/// are kept r_a + r_b apart, and in TS_CONTACT_MODE_SAMPLED_POINTS a particle touches a tool
+/// when its centre comes closer than this to the tool's samples. In the default
+/// TS_CONTACT_MODE_EXACT_SHAPE tools touch the boundary triangles, with a skin of a tenth of
+/// this radius.
 ///
 /// # Safety
 ///

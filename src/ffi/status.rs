@@ -27,7 +27,9 @@ pub enum ts_status {
     MeshError = 7,
     /// A saved state cannot be restored (truncated, corrupt, wrong version or other scene).
     BadState = 8,
-    /// The step produced NaN/Inf; the world was rolled back to its state before the step.
+    /// The step produced NaN/Inf or left the divergence limits of ts_settings (particle speed,
+    /// body extent, volume ratio); the world was rolled back to its state before the step and
+    /// the message names the body and the reason.
     Diverged = 9,
     /// An I/O error other than reading a mesh.
     IoError = 10,

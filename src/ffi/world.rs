@@ -13,9 +13,12 @@ use crate::world::World;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ts_contact_mode {
-    /// Exact distance from each particle to the tool's shape (the default): a smooth force.
+    /// The tool's exact shape against the body's deformed boundary triangles (the default):
+    /// contact starts a skin of a tenth of the particle radius out from the surface, one-sided
+    /// and swept, so tools thinner than the particle spacing do not slip in.
     ExactShape = 0,
-    /// The paper's mode: the tool surface sampled into points, particles pushed out of them.
+    /// The paper's mode: the tool surface sampled into points, particles (spheres of the
+    /// particle radius) pushed out of them; thin tools can slip between particles.
     SampledPoints = 1,
 }
 
@@ -319,9 +322,11 @@ pub unsafe extern "C" fn ts_world_set_settings(
 }
 
 /// Advance the world by settings.dt (substepping as stability requires). On
-/// TS_STATUS_DIVERGED the step produced NaN/Inf and the world was rolled back to its state
-/// before the call. `out_report` is optional (may be NULL); it is written on success only.
-/// Allocates nothing after the first step.
+/// TS_STATUS_DIVERGED the step produced NaN/Inf or left the divergence limits of ts_settings
+/// (particle speed, body extent, volume ratio) and the world was rolled back to its state
+/// before the call (time not advanced; the message names the body and the reason).
+/// `out_report` is optional (may be NULL); it is written on success only. Allocates nothing
+/// after the first step, except in a step in which a blade tool cuts.
 ///
 /// # Safety
 ///
@@ -429,7 +434,8 @@ pub unsafe extern "C" fn ts_world_tool_count(
     unsafe { world_value(world, out_count, "out_count", |w| w.tool_count() as u32) }
 }
 
-/// Number of steps so far that produced NaN/Inf and were rolled back (TS_STATUS_DIVERGED).
+/// Number of steps so far that diverged (NaN/Inf or outside the divergence limits) and were
+/// rolled back (TS_STATUS_DIVERGED).
 ///
 /// # Safety
 ///
