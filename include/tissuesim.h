@@ -275,7 +275,7 @@ typedef struct ts_material {
      */
     double youngs_modulus;
     /**
-     * Poisson ratio nu (dimensionless), in [0, 0.49]: negative values are auxetic (not
+     * Poisson ratio nu (dimensionless), in [0, 0.499]: negative values are auxetic (not
      * tissue) and unstable here; the volumetric stiffness diverges as nu approaches 0.5.
      */
     double poisson_ratio;

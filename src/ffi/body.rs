@@ -24,7 +24,7 @@ use std::sync::Arc;
 pub struct ts_material {
     /// Young's modulus E (Pa), > 0.
     pub youngs_modulus: f64,
-    /// Poisson ratio nu (dimensionless), in [0, 0.49]: negative values are auxetic (not
+    /// Poisson ratio nu (dimensionless), in [0, 0.499]: negative values are auxetic (not
     /// tissue) and unstable here; the volumetric stiffness diverges as nu approaches 0.5.
     pub poisson_ratio: f64,
     /// Mass density rho (kg/m^3), > 0.
