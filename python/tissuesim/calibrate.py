@@ -18,10 +18,12 @@ The optimiser (docs/CALIBRATION.md):
   probe). The fit is the root of log s(E) in log E, bracketed: each round simulates a batch of
   log-spaced candidates, interpolates the root between the two that bracket it, and narrows the
   bracket around it to half a candidate spacing.
-- Several parameters: successive refinement of a box: each round simulates a grid (3 points per
-  parameter, log E and the others linear), fits a quadratic to the sum of squared force errors,
-  moves the box's centre to its minimum (or the best candidate) and halves the box; E is then
-  refined by one bracket round as above at the other parameters found.
+- Several parameters: successive refinement of a box over the parameters other than E: each
+  round simulates a grid (a batch along one parameter, 3 points per parameter for more), fits a
+  quadratic to the sum of squared force errors, moves the box's centre to its minimum (or the
+  best candidate) and halves the box. E is profiled out meanwhile: each candidate's curve is
+  compared after its least-squares scaling, and the candidates' E follows the best one's scale.
+  One bracket round on E (±20 %) at the other parameters found ends the search.
 - A last simulation at the fitted parameters gives the fitted curve of the plot.
 """
 
@@ -75,7 +77,7 @@ class Range:
 
     def from_search(self, x: float) -> float:
         """The value from the search scale."""
-        return math.exp(x) if PARAMETERS[self.name].log else x
+        return math.exp(x) if PARAMETERS[self.name].log else float(x)
 
 
 def parse_range(text: str) -> Range:
@@ -211,27 +213,40 @@ def fit_box(
     ranges: Sequence[Range],
     points: int,
     rounds: int,
+    modulus: Range | None,
 ) -> Candidate:
-    """Several parameters by successive refinement of a box: per round a grid of ``points``
-    values per parameter, the box moved to the minimum of a quadratic fit of the squared force
-    error (or the best grid point) and halved."""
+    """Parameters other than E (``ranges``) by successive refinement of a box: per round a
+    grid of ``points`` values per parameter, the box moved to the minimum of a quadratic fit of
+    the squared force error (or to the best grid point) and halved. With ``modulus``, E is
+    profiled out: each candidate's error is that of its curve scaled by its least-squares
+    factor, and E follows the best candidate's factor (damped: force grows faster than E). The
+    E found is only a start for ``fit_modulus``."""
     lo = np.array([r.to_search(r.lo) for r in ranges])
     hi = np.array([r.to_search(r.hi) for r in ranges])
     centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     unit = np.linspace(-1.0, 1.0, points)
+    e = math.sqrt(modulus.lo * modulus.hi) if modulus else math.nan
     for _ in range(rounds):
         z = np.array(list(itertools.product(unit, repeat=len(ranges))))
         xs = centre + z * half
         candidates = [{r.name: r.from_search(x) for r, x in zip(ranges, row)} for row in xs]
-        errors = np.array([_squared_error(measured, f) for f in evaluate(candidates)])
-        if np.all(np.isinf(errors)):
-            raise RuntimeError("every simulation of the round failed (see the workers' log)")
+        if modulus:
+            candidates = [{modulus.name: e, **c} for c in candidates]
+        forces = evaluate(candidates)
+        scales = np.array([math.exp(_log_scale(measured, f)) if modulus else 1.0 for f in forces])
+        errors = np.array([_squared_error(measured, s * f) for s, f in zip(scales, forces)])
         ok = np.isfinite(errors)
-        best = _quadratic_minimum(z[ok], errors[ok])
-        centre = centre + half * (best if best is not None else z[np.argmin(errors)])
+        if not ok.any():
+            raise RuntimeError("every simulation of the round failed (see the workers' log)")
+        best = int(np.argmin(np.where(ok, errors, np.inf)))
+        if modulus:
+            e = float(np.clip(e * scales[best] ** 0.6, modulus.lo, modulus.hi))
+        step = _quadratic_minimum(z[ok], errors[ok])
+        centre = centre + half * (step if step is not None else z[best])
         half = 0.5 * half
         centre = np.clip(centre, lo + half, hi - half)
-    return {r.name: r.from_search(x) for r, x in zip(ranges, centre)}
+    values = {r.name: r.from_search(x) for r, x in zip(ranges, centre)}
+    return {modulus.name: e, **values} if modulus else values
 
 
 def check_search(ranges: Sequence[Range], batch: int, rounds: int | None) -> None:
@@ -265,14 +280,15 @@ def calibrate(
         n = rounds or 3
         values = {modulus.name: fit_modulus(measured, evaluate, modulus, {}, batch, n)}
     else:
-        n = rounds or 4
-        values = fit_box(measured, evaluate, ranges, 3 if len(ranges) > 1 else batch, n)
-        if modulus is not None:  # one bracket round on E at the other parameters found
-            others = {k: v for k, v in values.items() if k != modulus.name}
-            x = math.log(values[modulus.name])
-            width = (math.log(modulus.hi) - math.log(modulus.lo)) / 2**n
-            start = _narrow(x, width, math.log(modulus.lo), math.log(modulus.hi))
-            values[modulus.name] = fit_modulus(measured, evaluate, modulus, others, batch, 1, start)
+        others = [r for r in ranges if r is not modulus]
+        points = 3 if len(others) > 1 else batch
+        values = fit_box(measured, evaluate, others, points, rounds or 4, modulus)
+        if modulus is not None:  # one bracket round on E, ±20 %, at the others found
+            x = math.log(values.pop(modulus.name))
+            bounds = math.log(modulus.lo), math.log(modulus.hi)
+            start = _narrow(x, math.log(1.2), *bounds)
+            e = fit_modulus(measured, evaluate, modulus, values, batch, 1, start)
+            values = {modulus.name: e, **values}
     force = evaluate([values])[0]
     at_bound = [
         r.name
@@ -288,9 +304,10 @@ def planned_simulations(ranges: Sequence[Range], batch: int, rounds: int | None)
     """How many simulations ``calibrate`` runs (for the progress bar)."""
     if len(ranges) == 1 and ranges[0].name == "youngs_modulus":
         return (rounds or 3) * batch + 1
-    points = 3 if len(ranges) > 1 else batch
-    extra = batch if any(r.name == "youngs_modulus" for r in ranges) else 0
-    return (rounds or 4) * points ** len(ranges) + extra + 1
+    others = [r for r in ranges if r.name != "youngs_modulus"]
+    points = 3 if len(others) > 1 else batch
+    extra = batch if len(others) < len(ranges) else 0
+    return (rounds or 4) * points ** len(others) + extra + 1
 
 
 class DaskEvaluator:

@@ -52,7 +52,7 @@ def open_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         threads_per_worker=1,
         processes=True,
         dashboard_address=None,
-        silence_logs=logging.ERROR,
+        silence_logs=logging.CRITICAL,
     )
     with cluster, Client(cluster) as client:
         yield client

@@ -36,6 +36,7 @@ from ._tissuesim import (
     YOUNGS_MODULUS_RANGE,
     BodyModel,
     BodyOptions,
+    DivergedError,
     Material,
     Pose,
     Settings,
@@ -457,8 +458,12 @@ def press(scene: Scene, depth: float) -> Curve:
 
 def press_at(scene: Scene, depths: FloatArray) -> FloatArray:
     """The scene's simulated force (N) at each of ``depths`` (m, increasing), interpolated
-    linearly between steps: the task a Dask worker runs for one candidate."""
-    curve = press(scene, float(depths[-1]))
+    linearly between steps: the task a Dask worker runs for one candidate. NaN everywhere if
+    the simulation diverged (these parameters cannot be simulated in this scene)."""
+    try:
+        curve = press(scene, float(depths[-1]))
+    except DivergedError:
+        return np.full(len(depths), np.nan)
     return np.interp(depths, curve.depth, curve.force)
 
 
