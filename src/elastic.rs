@@ -31,7 +31,7 @@ use crate::math::{Mat3, Quat, Real, Vec3};
 use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
 use crate::pair_sums::{self, Kept, ShareForces};
 use crate::parallel::{Barrier, Pool, SharedSlice};
-use crate::rotation::extract_rotations;
+use crate::rotation::{extract_rotations, rotation_from_svd};
 use std::ops::Range;
 
 /// The constants of the elastic model of one body.
@@ -647,11 +647,34 @@ fn pair_forces<const DAMPED: bool>(
     fi
 }
 
+/// The elastic energy (J) at positions `x` (m) whose negative gradient the force pass
+/// computes (with the exact polar rotations):
+/// `Σ_i v_i [μ |F_i - R_i|² + λ/2 tr(R_iᵀF_i - I)²] + Σ_i Σ_j c_ij |ε_ij|² / 2`.
+pub(crate) fn energy(
+    model: &ElasticModel,
+    nbr: &Neighbourhoods,
+    volume: &[Real],
+    x: &[Vec3],
+) -> Real {
+    let mut total = 0.0;
+    for (i, vi) in volume.iter().enumerate() {
+        let f = deformation_gradient(nbr, x, i);
+        let r = rotation_from_svd(&f).to_rotation_matrix().into_inner();
+        let tr = (r.transpose() * f).trace() - 3.0;
+        total += vi * (model.mu * (f - r).norm_squared() + 0.5 * model.lambda * tr * tr);
+        for e in nbr.range(i) {
+            let j = nbr.index[e] as usize;
+            let eps = f * nbr.rest_offset.get(e) - (x[j] - x[i]);
+            total += 0.5 * model.hourglass * vi * nbr.hourglass_weight[e] * eps.norm_squared();
+        }
+    }
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::neighbours::{build, SupportRadius};
-    use crate::rotation::rotation_from_svd;
 
     /// A jittered 5×4×4 block of points (m), with a deterministic pseudo-random jitter.
     fn jittered_block() -> Vec<Vec3> {
@@ -680,24 +703,6 @@ mod tests {
         rest.iter()
             .map(|p| rot * Vec3::new(1.2 * p.x + 0.1 * p.y * p.y, 0.9 * p.y, p.z + 0.2 * p.x))
             .collect()
-    }
-
-    /// The elastic energy (J) whose negative gradient the force pass computes:
-    /// `Σ_i v_i [μ |F_i - R_i|² + λ/2 tr(R_iᵀF_i - I)²] + Σ_i Σ_j c_ij |ε_ij|² / 2`.
-    fn energy(model: &ElasticModel, nbr: &Neighbourhoods, volume: &[Real], x: &[Vec3]) -> Real {
-        let mut total = 0.0;
-        for (i, vi) in volume.iter().enumerate() {
-            let f = deformation_gradient(nbr, x, i);
-            let r = rotation_from_svd(&f).to_rotation_matrix().into_inner();
-            let tr = (r.transpose() * f).trace() - 3.0;
-            total += vi * (model.mu * (f - r).norm_squared() + 0.5 * model.lambda * tr * tr);
-            for e in nbr.range(i) {
-                let j = nbr.index[e] as usize;
-                let eps = f * nbr.rest_offset.get(e) - (x[j] - x[i]);
-                total += 0.5 * model.hourglass * vi * nbr.hourglass_weight[e] * eps.norm_squared();
-            }
-        }
-        total
     }
 
     fn forces(model: &ElasticModel, input: &ForceInputs<'_>, threads: usize) -> Vec<Vec3> {
