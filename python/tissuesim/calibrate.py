@@ -36,6 +36,7 @@ import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -51,6 +52,10 @@ from .indentation import (
     press_at,
     read_curve,
 )
+
+if TYPE_CHECKING:
+    from distributed import Client
+    from tqdm import tqdm
 
 Candidate = dict[str, float]
 """Parameter name -> value (SI units) of one simulation."""
@@ -314,7 +319,9 @@ class DaskEvaluator:
     """Runs candidates of ``scene`` on a Dask client, one task each (``press_at``), and
     counts them on a progress bar."""
 
-    def __init__(self, client, scene: Scene, depths: FloatArray, progress=None) -> None:
+    def __init__(
+        self, client: Client, scene: Scene, depths: FloatArray, progress: tqdm | None = None
+    ) -> None:
         self.client = client
         self.scene = scene
         self.depths = depths
@@ -406,7 +413,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     with open_client(args.workers, args.scheduler) as client:
         with tqdm(total=total, unit="sim", desc="calibrate", disable=args.no_progress) as bar:
             evaluate = DaskEvaluator(client, scene, curve.depth, bar)
-            fit = calibrate(curve, ranges, evaluate, args.batch, args.rounds)
+            try:
+                fit = calibrate(curve, ranges, evaluate, args.batch, args.rounds)
+            except RuntimeError as e:  # every candidate of a round failed
+                print(f"calibrate: error: {e}", file=sys.stderr)
+                return 1
         fit.simulations = evaluate.simulations
     title = ", ".join(format_value(k, v) for k, v in fit.values.items())
     plot_fit(plot, curve, fit, title)

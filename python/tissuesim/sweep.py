@@ -23,7 +23,7 @@ import sys
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -36,6 +36,10 @@ from .indentation import (
     load_scene,
     press_at,
 )
+
+if TYPE_CHECKING:
+    from distributed import Client
+    from tqdm import tqdm
 
 Point = dict[str, float]
 """Parameter name -> value (SI units) of one grid point."""
@@ -156,13 +160,13 @@ def fmu_press_at(fmu: str, scene: Scene, depths: FloatArray, step: float) -> Flo
 
 
 def run(
-    client,
+    client: Client,
     scene: Scene,
     points: Sequence[Point],
     depths: FloatArray,
     fmu: str | None = None,
     step: float = 0.01,
-    progress=None,
+    progress: tqdm | None = None,
 ) -> list[FloatArray]:
     """The force (N) at ``depths`` (m) of every grid point, one Dask task each (the package,
     or the FMU at ``fmu`` with communication step ``step``, s)."""
@@ -179,7 +183,9 @@ def run(
     return [np.asarray(f.result(), dtype=float) for f in futures]
 
 
-def write_csv(path: str | Path, points: Sequence[Point], depths: FloatArray, forces) -> None:
+def write_csv(
+    path: str | Path, points: Sequence[Point], depths: FloatArray, forces: Sequence[FloatArray]
+) -> None:
     """One row per grid point and depth: the parameters, ``depth_m`` (m), ``force_N`` (N)."""
     names = list(points[0])
     with open(path, "w", newline="", encoding="utf-8") as f:
@@ -190,7 +196,9 @@ def write_csv(path: str | Path, points: Sequence[Point], depths: FloatArray, for
                 w.writerow([*(repr(point[n]) for n in names), repr(float(d)), repr(float(fz))])
 
 
-def plot(path: str | Path, points: Sequence[Point], depths: FloatArray, forces) -> None:
+def plot(
+    path: str | Path, points: Sequence[Point], depths: FloatArray, forces: Sequence[FloatArray]
+) -> None:
     """A PNG of every grid point's force–indentation curve (mm, N)."""
     import matplotlib
 
