@@ -4,10 +4,14 @@
 //!
 //! ```text
 //! cargo run --release --example static_accuracy -- [--neighbours K] [--hourglass C]
-//!     [--nodal-volume] [--plain-mls] [--audit] [--nu 0.3,0.45,...] [SCENE ...]
+//!     [--nodal-volume] [--plain-mls] [--audit] [--tet-schemes] [--nu 0.3,0.45,...] [SCENE ...]
 //! ```
 //! The reference is P2 (displacement) below ν 0.45 and Taylor–Hood (mixed P2/P1,
 //! `*_th.csv`) from 0.45 up, where displacement-only P2 locks too (validation/README.md g).
+//! `--tet-schemes` adds columns for tetrahedral discretisations on the same nodes (assembled
+//! in `tet_schemes.rs`): linear tets (a check of the assembly against the reference's P1
+//! column), linear tets with the volumetric energy on the nodes' dual cells (the average nodal
+//! pressure tetrahedron), and face- and edge-smoothed shear with the same.
 //! `--audit` adds, per scene, the solution's best-fit scale against P2 (> 1: too soft) and the
 //! energy audit of `audit.rs`: the deviatoric energy of the P2 field as the particles see it,
 //! over what linear tetrahedra see, for the surface, interior and fixed particles.
@@ -18,6 +22,8 @@
 
 #[path = "static_accuracy/audit.rs"]
 mod audit;
+#[path = "static_accuracy/tet_schemes.rs"]
+mod tet_schemes;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -216,6 +222,7 @@ fn main() -> Res<()> {
     let mut settings = Settings::default();
     let mut names = Vec::new();
     let mut with_audit = false;
+    let mut with_schemes = false;
     let mut ratios = vec![0.3, 0.45];
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -232,6 +239,7 @@ fn main() -> Res<()> {
             "--tet-volume" => settings.volume_constraints = true,
             "--plain-mls" => options.consistent_gradients = false,
             "--audit" => with_audit = true,
+            "--tet-schemes" => with_schemes = true,
             s => names.push(s.to_string()),
         }
     }
@@ -240,7 +248,14 @@ fn main() -> Res<()> {
             .map(String::from)
             .to_vec();
     }
-    println!("scene | point-based vs reference | P1 vs reference");
+    if with_schemes {
+        println!(
+            "scene | point-based vs reference | P1 vs reference | P1 assembled here | \
+             tets + dual cells | faces + dual cells | edges + dual cells"
+        );
+    } else {
+        println!("scene | point-based vs reference | P1 vs reference");
+    }
     for scene in scenes(&names, &ratios)? {
         let Ok(reference) = read_reference(&scene.reference) else {
             println!(
@@ -276,7 +291,27 @@ fn main() -> Res<()> {
             })
             .map(|v| format!("{:.1}%", 100.0 * v))
             .unwrap_or_else(|| "-".into());
-        println!("{} | {:.1}% | {p1}", scene.name, 100.0 * e);
+        let mut line = format!("{} | {:.1}% | {p1}", scene.name, 100.0 * e);
+        if with_schemes {
+            use tet_schemes::{Shear, Volumetric};
+            for (shear, volumetric) in [
+                (Shear::Tets, Volumetric::Tets),
+                (Shear::Tets, Volumetric::DualCells),
+                (Shear::Faces, Volumetric::DualCells),
+                (Shear::Edges, Volumetric::DualCells),
+            ] {
+                let u = tet_schemes::linear_sag(
+                    &scene.mesh,
+                    &scene.fixed,
+                    scene.material,
+                    scene.g,
+                    shear,
+                    volumetric,
+                )?;
+                line += &format!(" | {:.1}%", 100.0 * rel_l2(&u, &scene.ids, &reference)?);
+            }
+        }
+        println!("{line}");
         if with_audit {
             print_audit(body, &u, &ids, &reference);
         }
