@@ -241,3 +241,18 @@ def test_several_parameters_are_found_by_the_box_refinement():
     assert fit.values["poisson_ratio"] == pytest.approx(0.31, abs=0.002)
     assert sum(calls) == cal.planned_simulations(ranges, 4, None)
     assert calls == [4, 4, 4, 4, 4, 1]
+
+
+def test_a_worker_builds_a_model_and_settles_once_per_material(scene):
+    """What each worker process keeps between tasks (tissuesim.indentation's caches)."""
+    ind._SETTLED.clear()
+    ind._model.cache_clear()
+    depth = quick_depth(scene) - 0.004
+    soft = scene.with_parameters({"youngs_modulus": 3100.0})
+    a = ind.press(soft, depth)
+    b = ind.press(soft.with_parameters({"friction_static": 0.5, "friction_kinetic": 0.3}), depth)
+    assert (ind._model.cache_info().misses, len(ind._SETTLED)) == (1, 1)  # reused
+    assert not np.array_equal(a.force, b.force)  # the friction did change the press
+    ind.press(scene.with_parameters({"youngs_modulus": 3200.0}), depth)
+    assert (ind._model.cache_info().misses, len(ind._SETTLED)) == (2, 2)  # a new material
+    assert np.array_equal(ind.press(soft, depth).force, a.force)  # the same bits from the cache

@@ -371,8 +371,9 @@ def _model(path: str, scale: float, material: tuple[float, float, float]) -> Bod
     return BodyModel(_organ(path, scale), options)
 
 
-_SETTLED: OrderedDict[Scene, bytes] = OrderedDict()
-"""Settled world states per process, keyed by the scene without its probe (most recent last)."""
+_SETTLED: OrderedDict[tuple[Any, ...], bytes] = OrderedDict()
+"""Settled world states per process, keyed by the scene's organ, fixed box, material, gravity
+and dt (most recent last)."""
 _SETTLED_KEEP = 16
 
 
@@ -384,8 +385,9 @@ def _at_rest(scene: Scene) -> tuple[World, int]:
     world.fix_box(organ, scene.fixed_min, scene.fixed_max)
     if not scene.settle:
         return world, int(organ)
-    # The organ's rest state does not depend on the probe or its friction.
-    key = replace(scene, friction_static=0.0, friction_kinetic=0.0, probe_start=(0.0, 0.0, 0.0))
+    # The organ's rest state does not depend on the probe.
+    key = (scene.mesh, scene.mesh_scale, scene.fixed_min, scene.fixed_max, material)
+    key += (scene.gravity, scene.dt)
     state = _SETTLED.get(key)
     if state is None:
         report = world.settle()
