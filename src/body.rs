@@ -466,7 +466,7 @@ impl Body {
     /// Thickness of the contact skin over the boundary surface (m): tools in the exact-shape
     /// contact mode touch the surface this far out of it (a tenth of the particle radius).
     pub fn contact_skin(&self) -> Real {
-        crate::solver::SURFACE_SKIN * self.model.particle_radius
+        crate::particles::SURFACE_SKIN * self.model.particle_radius
     }
     /// Total mass (kg).
     pub fn mass(&self) -> Real {

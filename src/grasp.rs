@@ -14,10 +14,10 @@
 //! [`World::release`](crate::World::release) lets go and contact acts again.
 
 use crate::body::Body;
-use crate::collision::tool::{Pose, Tool};
+use crate::collision::tool::{Pose, Tool, ToolLoad};
 use crate::error::{check_finite, Error};
 use crate::math::{Real, Vec3};
-use crate::solver::StepScratch;
+use crate::particles::ParticleViews;
 use parry3d_f64::math::Point;
 
 /// How a tool grasps.
@@ -165,35 +165,33 @@ impl Grasp {
     }
 
     /// One projection pass of every attachment towards the tool at pose `cur` for a substep `h`
-    /// (s); the particles' corrections (times their masses) go into `tool`'s wrench
-    /// accumulators and this grasp's own.
+    /// (s), on the particles of `views`; the particles' corrections (times their masses) go
+    /// into the tool's `load` and this grasp's own accumulator.
     pub(crate) fn project(
         &mut self,
-        tool: &mut Tool,
-        bodies: &[Body],
-        scratch: &mut [StepScratch],
+        views: &mut impl ParticleViews,
         cur: &Pose,
+        load: &mut ToolLoad,
         h: Real,
     ) {
         let iso = cur.isometry();
         for a in &mut self.attachments {
-            let b = a.body as usize;
-            let body = &bodies[b];
+            let view = views.view(a.body as usize);
             let i = a.particle as usize;
-            let w = body.inv_mass[i];
+            let w = view.inv_mass[i];
             if w == 0.0 {
                 continue;
             }
             let target = iso.transform_point(&Point::from(a.anchor)).coords;
-            let c = scratch[b].p[i] - target;
+            let c = view.p[i] - target;
             let alpha = a.compliance / (h * h);
             let dl = -(c + a.lambda * alpha) / (w + alpha);
             a.lambda += dl;
             let dp = dl * w;
-            scratch[b].p[i] += dp;
-            let impulse = dp * body.inertial_mass[i];
-            tool.acc_impulse += impulse;
-            tool.acc_moment += (target - cur.position).cross(&impulse);
+            view.p[i] += dp;
+            let impulse = dp * view.mass[i];
+            load.impulse += impulse;
+            load.moment += (target - cur.position).cross(&impulse);
             self.acc_impulse += impulse;
         }
     }

@@ -44,6 +44,7 @@ pub(crate) mod neighbours;
 pub(crate) mod pair_sums;
 pub(crate) mod parallel;
 pub(crate) mod particle_order;
+pub(crate) mod particles;
 pub mod render;
 pub(crate) mod rotation;
 pub(crate) mod settings;

@@ -23,10 +23,10 @@
 //! out and contact acts again.
 
 use crate::body::Body;
-use crate::collision::tool::{Pose, Tool, ToolShape};
+use crate::collision::tool::{Pose, Tool, ToolLoad, ToolShape};
 use crate::error::{check_finite, Error};
 use crate::math::{Real, Vec3};
-use crate::solver::StepScratch;
+use crate::particles::ParticleViews;
 use parry3d_f64::math::Point;
 
 /// How a needle punctures and holds the tissue.
@@ -215,24 +215,25 @@ impl Needle {
         }
     }
 
-    /// Start a substep at needle pose `cur`: hold the particles newly within reach of the
-    /// inserted shaft, let go of those the tip withdrew past, restart the multipliers.
-    pub(crate) fn begin_substep(&mut self, bodies: &[Body], cur: &Pose) {
+    /// Start a substep at needle pose `cur`: hold the particles (of `views`) newly within
+    /// reach of the inserted shaft, let go of those the tip withdrew past, restart the
+    /// multipliers.
+    pub(crate) fn begin_substep(&mut self, views: &mut impl ParticleViews, cur: &Pose) {
         let Some(b) = self.body else { return };
-        let body = &bodies[b as usize];
+        let view = views.view(b as usize);
         let iso = cur.isometry();
         let length = self.inserted_length(cur);
         let (top, bottom) = (self.tip, self.tip - length.max(0.0));
         let reach = self
             .options
             .reach
-            .unwrap_or(self.radius + 1.5 * body.model.particle_radius);
+            .unwrap_or(self.radius + 1.5 * view.radius);
         self.holds.retain(|h| h.anchor.y <= top);
         for h in &mut self.holds {
             h.lambda = Vec3::zeros();
         }
-        for (i, x) in body.state.x.iter().enumerate() {
-            if body.inv_mass[i] == 0.0 {
+        for (i, x) in view.x.iter().enumerate() {
+            if view.inv_mass[i] == 0.0 {
                 continue;
             }
             let local = iso.inverse_transform_point(&Point::from(*x)).coords;
@@ -251,38 +252,35 @@ impl Needle {
         }
     }
 
-    /// One projection pass of the held particles towards the shaft at pose `cur` for a substep
-    /// `h` (s): lateral XPBD constraints and axial stick-or-slip friction; the corrections
-    /// (times the particles' masses) go into `tool`'s wrench accumulators.
+    /// One projection pass of the held particles (of `views`) towards the shaft at pose `cur`
+    /// for a substep `h` (s): lateral XPBD constraints and axial stick-or-slip friction; the
+    /// corrections (times the particles' masses) go into the tool's `load`.
     pub(crate) fn project(
         &mut self,
-        tool: &mut Tool,
-        bodies: &[Body],
-        scratch: &mut [StepScratch],
+        views: &mut impl ParticleViews,
         cur: &Pose,
+        load: &mut ToolLoad,
         h: Real,
     ) {
         let Some(b) = self.body else { return };
-        let b = b as usize;
-        let body = &bodies[b];
         if self.holds.is_empty() {
             return;
         }
+        let view = views.view(b as usize);
         let iso = cur.isometry();
         let axis = Self::axis(cur);
-        let compliance =
-            1.0 / (body.model.options.material.youngs_modulus * body.model.particle_radius);
+        let compliance = 1.0 / (view.youngs_modulus * view.radius);
         let alpha = compliance / (h * h);
         // Each held particle's share of the friction force (N).
         let length = self.inserted_length(cur).max(0.0);
         let share = self.options.friction_per_length * length / self.holds.len() as Real;
         for hold in &mut self.holds {
             let i = hold.particle as usize;
-            let w = body.inv_mass[i];
+            let w = view.inv_mass[i];
             if w == 0.0 {
                 continue;
             }
-            let before = scratch[b].p[i];
+            let before = view.p[i];
             let local = iso.inverse_transform_point(&Point::from(before)).coords;
             // Lateral: towards the anchor's offset from the axis (local x, z).
             let c = Vec3::new(local.x - hold.anchor.x, 0.0, local.z - hold.anchor.z);
@@ -290,7 +288,7 @@ impl Needle {
             hold.lambda += dl;
             let lateral_world = cur.orientation * (dl * w);
             // Axial: stick if the force that takes is within the share, else slip with it.
-            let m = body.inertial_mass[i];
+            let m = view.mass[i];
             let stick = hold.anchor.y - local.y;
             let limit = share * h * h / m;
             let axial = stick.clamp(-limit, limit);
@@ -298,11 +296,11 @@ impl Needle {
                 hold.anchor.y = local.y + axial;
             }
             let dp = lateral_world + axis * axial;
-            scratch[b].p[i] += dp;
+            view.p[i] += dp;
             let impulse = dp * m;
-            tool.acc_impulse += impulse;
+            load.impulse += impulse;
             let at = iso.transform_point(&Point::from(hold.anchor)).coords;
-            tool.acc_moment += (at - cur.position).cross(&impulse);
+            load.moment += (at - cur.position).cross(&impulse);
         }
     }
 }

@@ -298,11 +298,22 @@ pub struct Tool {
     /// Linear velocity of the origin over the last step (m/s).
     pub(crate) linear_velocity: Vec3,
     pub(crate) wrench: Wrench,
-    /// Accumulators of the step in progress: Σ m Δx (kg·m), Σ (q - o) × m Δx (kg·m²).
-    pub(crate) acc_impulse: Vec3,
-    pub(crate) acc_moment: Vec3,
-    pub(crate) acc_contacts: u32,
-    pub(crate) acc_penetration: Real,
+    /// What the interactions put on the tool in the step in progress.
+    pub(crate) load: ToolLoad,
+}
+
+/// What the interactions (contact, grasp, needle) put on a tool during a step, accumulated
+/// over its substeps and turned into the tool's [`Wrench`] at its end.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct ToolLoad {
+    /// Σ m Δx of the corrections (kg·m).
+    pub(crate) impulse: Vec3,
+    /// Σ (q − o) × m Δx, q where the correction acts on the tool, o its origin (kg·m²).
+    pub(crate) moment: Vec3,
+    /// Contacts of the substep in progress (counted in its first iteration).
+    pub(crate) contacts: u32,
+    /// Deepest penetration seen in the step (m).
+    pub(crate) penetration: Real,
 }
 
 impl std::fmt::Debug for Tool {
@@ -376,10 +387,7 @@ impl Tool {
             sample_radius,
             linear_velocity: Vec3::zeros(),
             wrench: Wrench::default(),
-            acc_impulse: Vec3::zeros(),
-            acc_moment: Vec3::zeros(),
-            acc_contacts: 0,
-            acc_penetration: 0.0,
+            load: ToolLoad::default(),
         })
     }
 

@@ -35,10 +35,10 @@ mod surface_contact;
 mod volume;
 mod workspace;
 
-pub(crate) use surface_contact::{SurfaceScratch, SURFACE_SKIN};
+pub(crate) use surface_contact::SurfaceScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
-use crate::body::volume_on;
+use crate::body::{volume_on, Body};
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
@@ -46,9 +46,22 @@ use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
 use crate::parallel::SharedSlice;
+use crate::particles::{ParticleView, ParticleViews};
 use crate::settings::{ContactMode, MAX_THREADS};
 use crate::world::{StepReport, World};
 use parry3d_f64::math::{Isometry, Point};
+
+/// The bodies' particle views over their step scratch, by body index.
+struct Views<'a> {
+    bodies: &'a [Body],
+    scratch: &'a mut [StepScratch],
+}
+
+impl ParticleViews for Views<'_> {
+    fn view(&mut self, b: usize) -> ParticleView<'_> {
+        self.scratch[b].view(&self.bodies[b])
+    }
+}
 
 /// How far (m) the point of a tool now at `point` moved in this substep: `back` maps a point
 /// attached to the tool at the substep's end to where it was at its start.
@@ -75,9 +88,9 @@ impl World {
         }
         let h = self.settings.dt / n as Real;
         for t in self.tools.iter_mut().flatten() {
-            t.acc_impulse = Vec3::zeros();
-            t.acc_moment = Vec3::zeros();
-            t.acc_penetration = 0.0;
+            t.load.impulse = Vec3::zeros();
+            t.load.moment = Vec3::zeros();
+            t.load.penetration = 0.0;
         }
         for k in 1..=n {
             self.substep(h, k, n);
@@ -139,10 +152,10 @@ impl World {
         for t in self.tools.iter_mut().flatten() {
             let scale = -1.0 / (h * h * n as Real);
             t.wrench = Wrench {
-                force: t.acc_impulse * scale,
-                torque: t.acc_moment * scale,
-                contact_count: t.acc_contacts,
-                max_penetration: t.acc_penetration,
+                force: t.load.impulse * scale,
+                torque: t.load.moment * scale,
+                contact_count: t.load.contacts,
+                max_penetration: t.load.penetration,
             };
             t.linear_velocity = (t.target.position - t.pose.position) / dt;
             t.pose = t.target;
@@ -183,14 +196,18 @@ impl World {
                 .build(scratch.iter().map(|s| s.p.as_slice()), cell);
         }
         for t in self.tools.iter_mut().flatten() {
-            t.acc_contacts = 0;
+            t.load.contacts = 0;
         }
         self.grasps.iter_mut().for_each(Grasp::begin_substep);
         let s_cur = k as Real / n as Real;
         for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
             if let (Some(tool), Some(needle)) = (tool, needle) {
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                needle.begin_substep(&self.bodies, &cur);
+                let mut views = Views {
+                    bodies: &self.bodies,
+                    scratch,
+                };
+                needle.begin_substep(&mut views, &cur);
             }
         }
         let s_prev = (k - 1) as Real / n as Real;
@@ -233,8 +250,8 @@ impl World {
                         ContactMode::ExactShape => surface_contact::project_tool_surface(
                             &mut self.workspace.surface,
                             tool,
-                            body,
-                            scratch,
+                            scratch.view(body),
+                            &body.model.boundary,
                             motion,
                             max_correction,
                             it == 0,
@@ -242,8 +259,7 @@ impl World {
                         ),
                         ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
                             tool,
-                            body,
-                            scratch,
+                            scratch.view(body),
                             motion,
                             max_correction,
                             it == 0,
@@ -255,14 +271,22 @@ impl World {
                 if let Some(tool) = tool {
                     if !grasp.attachments.is_empty() {
                         let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                        grasp.project(tool, &self.bodies, scratch, &cur, h);
+                        let mut views = Views {
+                            bodies: &self.bodies,
+                            scratch,
+                        };
+                        grasp.project(&mut views, &cur, &mut tool.load, h);
                     }
                 }
             }
             for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
                 if let (Some(tool), Some(needle)) = (tool, needle) {
                     let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                    needle.project(tool, &self.bodies, scratch, &cur, h);
+                    let mut views = Views {
+                        bodies: &self.bodies,
+                        scratch,
+                    };
+                    needle.project(&mut views, &cur, &mut tool.load, h);
                 }
             }
         }

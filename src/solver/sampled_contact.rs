@@ -8,23 +8,22 @@
 //! meets the samples only once it is out: the samples alone would push it out of each sample
 //! separately, in directions that fight, and a particle deep inside meets none of them.
 
-use crate::body::Body;
 use crate::collision::tool::{Pose, Tool};
 use crate::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
-use crate::solver::{tool_motion_at, StepScratch};
+use crate::particles::ParticleView;
+use crate::solver::tool_motion_at;
 use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
-/// `motion.1` over this substep) and the particles of `body`, with friction, each normal
+/// `motion.1` over this substep) and the particles of a body (`view`), with friction, each normal
 /// correction leaving the particle's motion along the normal in this substep at most the
 /// tool's motion along it plus `max_correction` (m), and accumulate the tool's impulse and
 /// moment.
 pub(crate) fn project_sampled_contacts(
     tool: &mut Tool,
-    body: &Body,
-    scratch: &mut StepScratch,
+    view: ParticleView<'_>,
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
     count: bool,
@@ -33,14 +32,14 @@ pub(crate) fn project_sampled_contacts(
     // Maps a point attached to the tool at `cur` to where it was at `prev`.
     let back = prev.isometry() * iso.inverse();
     let centre = cur.position;
-    let r = body.model.particle_radius;
+    let r = view.radius;
     let reach = tool.bounding_radius + r;
     let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
-    for i in 0..body.state.x.len() {
-        if body.inv_mass[i] == 0.0 {
+    for i in 0..view.x.len() {
+        if view.inv_mass[i] == 0.0 {
             continue;
         }
-        let before = scratch.p[i];
+        let before = view.p[i];
         if (before - centre).norm_squared() > reach * reach {
             continue;
         }
@@ -49,9 +48,9 @@ pub(crate) fn project_sampled_contacts(
         let mut touched: Option<Vec3> = None;
         let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
             let tool_motion = tool_motion_at(&back, &contact);
-            let rel = (*p - body.state.x[i]) - tool_motion;
+            let rel = (*p - view.x[i]) - tool_motion;
             *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
-            tool.acc_penetration = tool.acc_penetration.max(c.depth);
+            tool.load.penetration = tool.load.penetration.max(c.depth);
             touched = Some(contact);
         };
         // The depenetration cap, as in the exact-shape mode: after a contact the particle moves
@@ -59,7 +58,7 @@ pub(crate) fn project_sampled_contacts(
         // substep. Tissue moving into the tool is stopped whole, the tool pushes the tissue at
         // its own speed, and older penetration (a jump into the tissue) is removed at
         // `max_depenetration_speed`, however many samples overlap the particle.
-        let start = body.state.x[i];
+        let start = view.x[i];
         let cap = |p: &Vec3, normal: &Vec3, contact: &Vec3| {
             let tool_motion = tool_motion_at(&back, contact);
             let pushed = tool_motion.dot(normal).max(0.0);
@@ -86,13 +85,13 @@ pub(crate) fn project_sampled_contacts(
             }
         }
         if let Some(contact) = touched {
-            let impulse = (p - before) * body.inertial_mass[i];
-            tool.acc_impulse += impulse;
-            tool.acc_moment += (contact - centre).cross(&impulse);
+            let impulse = (p - before) * view.mass[i];
+            tool.load.impulse += impulse;
+            tool.load.moment += (contact - centre).cross(&impulse);
             if count {
-                tool.acc_contacts += 1;
+                tool.load.contacts += 1;
             }
-            scratch.p[i] = p;
+            view.p[i] = p;
         }
     }
 }

@@ -30,22 +30,17 @@
 //!   far side, on the line along `n` through the foot of the tool's middle, is `r` in front of it;
 //! - otherwise (a tool inside the body, e.g. after a teleport) the minimal separation.
 
-use crate::body::Body;
 use crate::collision::tool::{Pose, Tool, ToolShape};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
 use crate::parallel::{Pool, SharedSlice};
-use crate::solver::{tool_motion_at, StepScratch};
+use crate::particles::{ParticleView, SURFACE_SKIN};
+use crate::solver::tool_motion_at;
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CSOPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::{PointQuery, Ray};
 use parry3d_f64::shape::{Ball, Capsule, Cuboid, SupportMap, Triangle};
-
-/// Thickness of the contact skin over the boundary surface, in particle radii: contact starts
-/// this far out (0.6 mm on the default organ), so that a tool resting on the surface stays in
-/// contact from one substep to the next instead of touching and leaving it in turn.
-pub(crate) const SURFACE_SKIN: Real = 0.1;
 
 /// Most Gauss–Seidel passes over the triangles near a tool per projection.
 pub(crate) const MAX_SURFACE_PASSES: usize = 8;
@@ -127,7 +122,7 @@ impl std::fmt::Debug for SurfaceScratch {
 }
 
 /// Project the contacts between `tool` (moving from `motion.0` to `motion.1` over this substep)
-/// and the boundary triangles of `body` (moving its predicted positions in `predicted`), each
+/// and the `boundary` triangles of a body (moving its particles' predicted positions in `view`), each
 /// correction leaving the contact point's motion along the contact direction in this substep at
 /// most the tool's own motion along it plus `max_correction` (m), in up to
 /// [`MAX_SURFACE_PASSES`] passes (until the largest correction of a pass is below
@@ -138,8 +133,8 @@ impl std::fmt::Debug for SurfaceScratch {
 pub(crate) fn project_tool_surface(
     surface: &mut SurfaceScratch,
     tool: &mut Tool,
-    body: &Body,
-    predicted: &mut StepScratch,
+    view: ParticleView<'_>,
+    boundary: &[[u32; 3]],
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
     count: bool,
@@ -149,7 +144,7 @@ pub(crate) fn project_tool_surface(
     let iso_prev = prev.isometry();
     // Maps a point attached to the tool at `cur` to where it was at `prev`.
     let back = iso_prev * iso.inverse();
-    let skin = SURFACE_SKIN * body.model.particle_radius;
+    let skin = SURFACE_SKIN * view.radius;
     let reach = tool.bounding_radius + skin;
     let (mu_s, mu_k) = (tool.options.friction_static, tool.options.friction_kinetic);
     let hull = match &tool.description {
@@ -164,7 +159,6 @@ pub(crate) fn project_tool_surface(
         near,
         residual,
     } = surface;
-    let boundary = &body.model.boundary;
     near.clear();
     residual.clear();
     if near.capacity() < boundary.len() {
@@ -175,11 +169,12 @@ pub(crate) fn project_tool_surface(
     // Broad phase, once: the triangles with a free corner near the tool's path, flagged on the
     // pool, then listed in order (the same list for any thread count).
     let path = PathBox::new(&prev.position, &cur.position, reach);
-    let p = &predicted.p;
+    let p = &*view.p;
+    let inv_mass = view.inv_mass;
     let near_path = |t: usize| {
         let corners = boundary[t].map(|k| k as usize);
         let [a, b, c] = corners.map(|k| p[k]);
-        if !path.may_reach([&a, &b, &c]) || corners.iter().all(|&k| body.inv_mass[k] == 0.0) {
+        if !path.may_reach([&a, &b, &c]) || corners.iter().all(|&k| inv_mass[k] == 0.0) {
             return false;
         }
         let centroid = (a + b + c) / 3.0;
@@ -206,15 +201,15 @@ pub(crate) fn project_tool_surface(
     for pass in 0..MAX_SURFACE_PASSES {
         let mut largest: Real = 0.0;
         for (&t, left) in near.iter().zip(residual.iter_mut()) {
-            let corners = body.model.boundary[t as usize].map(|k| k as usize);
-            let w = corners.map(|k| body.inv_mass[k]);
-            let [a, b, c] = corners.map(|k| predicted.p[k]);
+            let corners = boundary[t as usize].map(|k| k as usize);
+            let w = corners.map(|k| view.inv_mass[k]);
+            let [a, b, c] = corners.map(|k| view.p[k]);
             let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
                 continue;
             };
             // Which side the tool came from: its middle at the substep's start against the
             // triangle at the substep's start (before the iterations moved or turned it).
-            let [a0, b0, c0] = corners.map(|k| body.state.x[k]);
+            let [a0, b0, c0] = corners.map(|k| view.x[k]);
             let n0 = (b0 - a0).cross(&(c0 - a0)).try_normalize(0.0).unwrap_or(n);
             let middle_prev = middle(map, &iso_prev, &n0);
             let from_front = (middle_prev - a0).dot(&n0) >= 0.0;
@@ -231,7 +226,7 @@ pub(crate) fn project_tool_surface(
                 continue;
             }
             let moved: Vec3 = (0..3)
-                .map(|k| (predicted.p[corners[k]] - body.state.x[corners[k]]) * weights[k])
+                .map(|k| (view.p[corners[k]] - view.x[corners[k]]) * weights[k])
                 .sum();
             // The depenetration cap: after the correction the contact point moves along the
             // contact direction by at most the tool's motion along it plus `max_correction` in
@@ -266,14 +261,14 @@ pub(crate) fn project_tool_surface(
             let mut impulse = Vec3::zeros();
             for k in 0..3 {
                 let dp = shift * shares[k];
-                predicted.p[corners[k]] += dp;
-                impulse += dp * body.inertial_mass[corners[k]];
+                view.p[corners[k]] += dp;
+                impulse += dp * view.mass[corners[k]];
             }
-            tool.acc_impulse += impulse;
-            tool.acc_moment += (contact.point - cur.position).cross(&impulse);
-            tool.acc_penetration = tool.acc_penetration.max(depth);
+            tool.load.impulse += impulse;
+            tool.load.moment += (contact.point - cur.position).cross(&impulse);
+            tool.load.penetration = tool.load.penetration.max(depth);
             if count && pass == 0 {
-                tool.acc_contacts += 1;
+                tool.load.contacts += 1;
             }
         }
         if largest <= SURFACE_PASS_TOLERANCE * skin {

@@ -2,10 +2,12 @@
 //! from the bodies (model and state), sized when bodies are added and reused, so that a step
 //! allocates nothing.
 
+use crate::body::Body;
 use crate::body_model::BodyModel;
 use crate::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
 use crate::math::{Real, Vec3};
+use crate::particles::ParticleView;
 use crate::solver::SurfaceScratch;
 use crate::world_state::WorldState;
 
@@ -44,6 +46,19 @@ impl StepScratch {
         };
         scratch.size_kept(model, threads);
         scratch
+    }
+
+    /// The particle view of `body` (the body this scratch is for) that the interactions act
+    /// on: these predicted positions, the body's positions and masses.
+    pub(crate) fn view<'a>(&'a mut self, body: &'a Body) -> ParticleView<'a> {
+        ParticleView {
+            p: &mut self.p,
+            x: &body.state.x,
+            inv_mass: &body.inv_mass,
+            mass: &body.inertial_mass,
+            radius: body.model.particle_radius,
+            youngs_modulus: body.model.options.material.youngs_modulus,
+        }
     }
 
     /// Size the force pass's kept forces for `threads` threads: a body's worth on several,
