@@ -192,7 +192,10 @@ fn p1_error(p1_file: &str, file: &str) -> Real {
 #[test]
 fn against_taylor_hood_on_meshes_from_another_mesher() {
     for (name, cases) in [
-        ("kidney_gmsh", [(0.45, 0.064), (0.49, 0.188), (0.499, 0.501)]),
+        (
+            "kidney_gmsh",
+            [(0.45, 0.064), (0.49, 0.188), (0.499, 0.501)],
+        ),
         ("liver_gmsh", [(0.45, 0.042), (0.49, 0.180), (0.499, 0.524)]),
     ] {
         let mesh = mesh::load(&common::mesh_path(&format!("{name}.node")), 1.0)
