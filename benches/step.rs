@@ -2,7 +2,8 @@
 //! max, mean), cost per particle, memory per particle; with and without a probe in contact.
 //!
 //! ```text
-//! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k] [--steps N]
+//! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
+//!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
 //!                             [--times PATH]
 //! ```
@@ -15,13 +16,18 @@
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
 //! by 15% of its size. `--threads` sets `Settings::threads` (default 1).
+//!
+//! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
+//! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
+//! side, hanging), all at the scene's scale and material, with organ–organ contact; the probe
+//! presses liver_4k.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use tissuesim::{
-    mesh, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+    mesh, BodyId, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
 };
 
 /// Counts live heap bytes, for memory per particle.
@@ -120,31 +126,89 @@ fn mesh_path(file: &str) -> PathBuf {
     path
 }
 
-fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row {
+/// The mesh `name` scaled by `scale` and centred on the origin.
+fn centred_mesh(name: &str, scale: Real) -> mesh::TetMesh {
     let path = mesh_path(&format!("{name}.node"));
-    let (mut organ, _) = mesh::load(&path, scene.scale).unwrap_or_else(|e| panic!("{e}"));
+    let (mut organ, _) = mesh::load(&path, scale).unwrap_or_else(|e| panic!("{e}"));
     let (lo, hi) = organ.bounding_box();
     let centre = (lo + hi) * 0.5;
     for p in &mut organ.nodes {
         *p -= centre;
     }
-    let (lo, hi) = organ.bounding_box();
+    organ
+}
+
+/// Add `organ` moved by `offset` (m) to `world`, its particles within `fraction` of its height
+/// from the top (`from_top`) or the bottom fixed; returns the body and its bounding box.
+fn add_organ(
+    world: &mut World,
+    organ: &mesh::TetMesh,
+    offset: Vec3,
+    options: &BodyOptions,
+    (fraction, from_top): (Real, bool),
+) -> (BodyId, Vec3, Vec3) {
+    let mut moved = organ.clone();
+    moved.nodes.iter_mut().for_each(|p| *p += offset);
+    let (lo, hi) = moved.bounding_box();
+    let body = world.add_body(&moved, options).unwrap();
+    let far = 10.0 * (hi - lo).max();
+    let (bottom, top) = if from_top {
+        (hi.y - fraction * (hi.y - lo.y), hi.y + far)
+    } else {
+        (lo.y - far, lo.y + fraction * (hi.y - lo.y))
+    };
+    world
+        .fix_box(
+            body,
+            Vec3::new(lo.x - far, bottom, lo.z - far),
+            Vec3::new(hi.x + far, top, hi.z + far),
+        )
+        .unwrap();
+    (body, lo, hi)
+}
+
+/// The organs of the scene `name`: one mesh hanging from its top, or `three_organs` — liver_4k
+/// hanging, kidney_gmsh under it (touching, held at its bottom) and liver_1k6 beside it
+/// (touching on the −x side, hanging): organ–organ contact in the step. Returns the bodies and
+/// the bounding box of the first (the one the probe presses).
+fn add_organs(world: &mut World, name: &str, scene: Scene) -> (Vec<BodyId>, Vec3, Vec3) {
+    let options = BodyOptions {
+        material: scene.material,
+        ..BodyOptions::default()
+    };
+    let hanging = (scene.fixed_fraction, true);
+    if name != "three_organs" {
+        let organ = centred_mesh(name, scene.scale);
+        let (body, lo, hi) = add_organ(world, &organ, Vec3::zeros(), &options, hanging);
+        return (vec![body], lo, hi);
+    }
+    let liver = centred_mesh("liver_4k", scene.scale);
+    let (a, lo, hi) = add_organ(world, &liver, Vec3::zeros(), &options, hanging);
+    let kidney = centred_mesh("kidney_gmsh", scene.scale);
+    let below = Vec3::new(0.0, lo.y - kidney.bounding_box().1.y, 0.0);
+    let (b, ..) = add_organ(
+        world,
+        &kidney,
+        below,
+        &options,
+        (scene.fixed_fraction, false),
+    );
+    let lobe = centred_mesh("liver_1k6", scene.scale);
+    let beside = Vec3::new(lo.x - lobe.bounding_box().1.x, 0.0, 0.0);
+    let (c, ..) = add_organ(world, &lobe, beside, &options, hanging);
+    (vec![a, b, c], lo, hi)
+}
+
+fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let settings = Settings {
         threads,
         ..Settings::default()
     };
     let mut world = World::new(settings).unwrap();
-    let options = BodyOptions {
-        material: scene.material,
-        ..BodyOptions::default()
-    };
-    let body = world.add_body(&organ, &options).unwrap();
+    let (bodies, lo, hi) = add_organs(&mut world, name, scene);
     let top = hi.y - scene.fixed_fraction * (hi.y - lo.y);
-    let far = 10.0 * (hi - lo).max();
-    world
-        .fix_box(body, Vec3::new(-far, top, -far), Vec3::new(far, far, far))
-        .unwrap();
+    let organ_nodes: Vec<Vec3> = world.body(bodies[0]).unwrap().rest_positions().to_vec();
     let bytes = LIVE.load(Ordering::Relaxed) - live0;
     // The probe: a sphere on the +z side at mid-height, moved in along -z until it is pressed
     // `press` past the first particle it meets.
@@ -152,8 +216,7 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row
     let radius = 0.05 * size;
     let press = 0.15 * size;
     let y_mid = 0.5 * (lo.y + top);
-    let surface_z = organ
-        .nodes
+    let surface_z = organ_nodes
         .iter()
         .filter(|p| (p.x.powi(2) + (p.y - y_mid).powi(2)).sqrt() < radius)
         .map(|p| p.z)
@@ -201,12 +264,17 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row
     let mean = times.iter().sum::<f64>() / times.len() as f64;
     let series = times.clone();
     times.sort_by(|a, b| a.total_cmp(b));
-    let b = world.body(body).unwrap();
+    let (mut particles, mut pairs) = (0, 0);
+    for &b in &bodies {
+        let b = world.body(b).unwrap();
+        particles += b.particle_count();
+        pairs += b.neighbourhoods().pair_count();
+    }
     Row {
         mesh: name.to_string(),
         probe,
-        particles: b.particle_count(),
-        pairs: b.neighbourhoods().pair_count(),
+        particles,
+        pairs,
         substeps: world.substeps_needed().0,
         median: percentile(&times, 0.5),
         p99: percentile(&times, 0.99),

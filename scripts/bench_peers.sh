@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Speed: tissuesim against Bender's PositionBasedDynamics (pypbd) on the same meshes, scene and
 # dt, in one run (each on one thread and on two); then tissuesim alone on the DESIGN §7 haptic
-# scene with and without a probe.
+# scene with and without a probe (the four livers and the three-organ scene), the speed-up of two
+# threads over one with the serial share it implies (Amdahl) and its projection to 4-16 threads.
 #
 #   scripts/bench_peers.sh [meshes (default liver_1k6,liver_4k,liver_10k)] [steps (default 1000)]
 #
@@ -11,7 +12,8 @@
 # bench --bench step -- --scene pypbd --threads N). The peer prints a mean over its steps, so the
 # ratios are of means (1 thread vs 1 thread, 2 vs 2); tissuesim's median and p99 are given beside
 # them. Writes docs/data/peers.csv, docs/data/bench_haptic.csv and docs/data/step_times_haptic.txt
-# (the haptic scene's step-time distribution). Run it on an idle machine.
+# (the haptic scene's step-time distribution), docs/data/speedup_haptic.txt. Run it on an idle
+# machine.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -51,9 +53,18 @@ done
 echo
 echo "DESIGN §7 haptic scene (SI, dt = 1 ms), 1 and 2 threads:"
 for t in 1 2; do
-  cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k --steps "$STEPS" --threads "$t" --csv "$TMP/h$t.csv" --times "$TMP/times$t.csv"
+  cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs --steps "$STEPS" --threads "$t" --csv "$TMP/h$t.csv" --times "$TMP/times$t.csv"
 done
 { cat "$TMP/h1.csv"; tail -n +2 "$TMP/h2.csv"; } > "$OUT/bench_haptic.csv"
+echo
+echo "Haptic scene, two threads against one (same run; medians). Serial share s from Amdahl's law"
+echo "(speed-up S on 2 threads = 1/(s + (1-s)/2), so s = 2/S - 1) and what it projects to 4, 8, 16 threads:"
+awk -F, 'NR == FNR { if (FNR > 1) one[$3 "," $4] = $8; next }
+  FNR > 1 { k = $3 "," $4; if (k in one) {
+    S = one[k] / $8; s = 2 / S - 1; if (s < 0) s = 0; if (s > 1) s = 1
+    printf "%-13s probe %-5s  1t %7.3f ms  2t %7.3f ms  speed-up %.2fx  serial %4.1f%%  ->  4t %.1fx  8t %.1fx  16t %.1fx\n",
+      $3, $4, one[k], $8, S, 100 * s, 1 / (s + (1 - s) / 4), 1 / (s + (1 - s) / 8), 1 / (s + (1 - s) / 16) } }' \
+  "$TMP/h1.csv" "$TMP/h2.csv" | tee "$OUT/speedup_haptic.txt"
 echo
 echo "Haptic scene, the distribution of the step times (scripts/step_times.py):"
 python3 scripts/step_times.py "$TMP/times1.csv" "$TMP/times2.csv" | tee "$OUT/step_times_haptic.txt"
