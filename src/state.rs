@@ -338,9 +338,10 @@ impl World {
             let cuts = crate::cut::cut_sets(b).map_or(0, |c| c.0.len() + c.1.len());
             (b.particle_count(), cuts)
         });
-        let tools = (self.tools.iter().zip(&self.grasps).zip(&self.needles))
-            .filter(|((t, _), _)| t.is_some())
-            .map(|((_, g), n)| (g.attachments.len(), n.as_ref().map_or(0, |n| n.holds.len())));
+        let tools = (self.tools.iter().flatten()).map(|s| {
+            let holds = s.needle.as_ref().map_or(0, |n| n.holds.len());
+            (s.grasp.attachments.len(), holds)
+        });
         layout_size(bodies, tools)
     }
 

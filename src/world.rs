@@ -3,7 +3,7 @@
 
 use crate::body::{Body, BodyOptions};
 use crate::body_model::BodyModel;
-use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
+use crate::collision::tool::{check_friction, Pose, Tool, ToolLoad, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
@@ -53,18 +53,42 @@ pub(crate) struct PairFriction {
     pub(crate) mu_k: Real,
 }
 
+/// One tool of a world: its shape and pose, what the interactions put on it during a step, and
+/// the roles it plays (a tool may grasp, be a needle and be a blade at once).
+#[derive(Debug)]
+pub(crate) struct ToolSlot {
+    /// Shape, pose, target pose, options, last wrench.
+    pub(crate) tool: Tool,
+    /// What contact, grasp and needle put on the tool in the step in progress.
+    pub(crate) load: ToolLoad,
+    /// The tool's grasp (no attachments: not grasping).
+    pub(crate) grasp: Grasp,
+    /// The tool's needle (`None`: not a needle).
+    pub(crate) needle: Option<Needle>,
+    /// Whether the tool is a blade.
+    pub(crate) blade: bool,
+}
+
+impl ToolSlot {
+    /// A tool that is neither grasping, a needle nor a blade.
+    fn new(tool: Tool) -> ToolSlot {
+        ToolSlot {
+            tool,
+            load: ToolLoad::default(),
+            grasp: Grasp::default(),
+            needle: None,
+            blade: false,
+        }
+    }
+}
+
 /// A simulated scene.
 pub struct World {
     pub(crate) settings: Settings,
     pub(crate) bodies: Vec<Body>,
-    /// Tools by id; `None` for a removed tool (ids are never reused).
-    pub(crate) tools: Vec<Option<Tool>>,
-    /// The grasp of each tool, by tool id (no attachments: not grasping).
-    pub(crate) grasps: Vec<Grasp>,
-    /// The needle of each tool, by tool id (`None`: not a needle).
-    pub(crate) needles: Vec<Option<Needle>>,
-    /// Whether each tool, by id, is a blade.
-    pub(crate) blades: Vec<bool>,
+    /// The tools, one slot each, by id ([`ToolId`] is the index); `None` for a removed tool
+    /// (ids are never reused).
+    pub(crate) tools: Vec<Option<ToolSlot>>,
     pub(crate) render_surfaces: Vec<RenderSurface>,
     pub(crate) pair_friction: Vec<PairFriction>,
     /// All the memory a step uses and throws away.
@@ -83,9 +107,6 @@ impl World {
             settings,
             bodies: Vec::new(),
             tools: Vec::new(),
-            grasps: Vec::new(),
-            needles: Vec::new(),
-            blades: Vec::new(),
             render_surfaces: Vec::new(),
             pair_friction: Vec::new(),
             workspace: Default::default(),
@@ -286,22 +307,16 @@ impl World {
             .unwrap_or(0.005);
         let id = u32::try_from(self.tools.len())
             .map_err(|_| Error::InvalidArgument("no tool id left".into()))?;
-        self.tools
-            .push(Some(Tool::new(shape, pose, options, spacing)?));
-        self.grasps.push(Grasp::default());
-        self.needles.push(None);
-        self.blades.push(false);
+        let tool = Tool::new(shape, pose, options, spacing)?;
+        self.tools.push(Some(ToolSlot::new(tool)));
         Ok(ToolId(id))
     }
     /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
     /// unused (later tools get new ids; calls with the removed id give
     /// [`Error::UnknownTool`]). Nothing changes on error.
     pub fn remove_tool(&mut self, id: ToolId) -> Result<(), Error> {
-        self.tool(id)?;
+        self.slot(id)?;
         self.tools[id.0 as usize] = None;
-        self.grasps[id.0 as usize] = Grasp::default();
-        self.needles[id.0 as usize] = None;
-        self.blades[id.0 as usize] = false;
         Ok(())
     }
     /// Cut body `id` with `blade` now (see [`crate::cut`]): the neighbour pairs and tetrahedra
@@ -319,9 +334,10 @@ impl World {
     /// its edge swept during the step, and it does not push the tissue (a blade slices). Nothing
     /// changes on error.
     pub fn make_blade(&mut self, id: ToolId) -> Result<(), Error> {
-        match self.tool(id)?.description {
+        let slot = self.slot_mut(id)?;
+        match slot.tool.description {
             ToolShape::Capsule { .. } | ToolShape::Cylinder { .. } => {
-                self.blades[id.0 as usize] = true;
+                slot.blade = true;
                 Ok(())
             }
             _ => Err(Error::InvalidArgument(
@@ -334,20 +350,19 @@ impl World {
     /// force, then holds the tissue on its shaft with axial friction (see [`crate::needle`]).
     /// Nothing changes on error.
     pub fn make_needle(&mut self, id: ToolId, options: &NeedleOptions) -> Result<(), Error> {
-        let needle = Needle::new(self.tool(id)?, *options)?;
-        self.needles[id.0 as usize] = Some(needle);
+        let slot = self.slot_mut(id)?;
+        slot.needle = Some(Needle::new(&slot.tool, *options)?);
         Ok(())
     }
     /// The insertion state of needle `id` ([`Error::InvalidArgument`] if the tool is not a
     /// needle).
     pub fn needle_state(&self, id: ToolId) -> Result<NeedleState, Error> {
-        let tool = self.tool(id)?;
-        let needle = self.needles[id.0 as usize]
-            .as_ref()
+        let slot = self.slot(id)?;
+        let needle = (slot.needle.as_ref())
             .ok_or_else(|| Error::InvalidArgument(format!("tool {} is not a needle", id.0)))?;
         Ok(NeedleState {
             punctured: needle.body.is_some(),
-            inserted_length: needle.inserted_length(&tool.pose).max(0.0),
+            inserted_length: needle.inserted_length(&slot.tool.pose).max(0.0),
             held: needle.holds.len(),
         })
     }
@@ -358,21 +373,19 @@ impl World {
     /// one. Returns the number of grasped particles (0: nothing within reach, not an error).
     /// Nothing changes on error.
     pub fn grasp(&mut self, id: ToolId, options: &GraspOptions) -> Result<usize, Error> {
-        let grasp = Grasp::new(self.tool(id)?, &self.bodies, options)?;
+        let grasp = Grasp::new(&self.slot(id)?.tool, &self.bodies, options)?;
         let count = grasp.attachments.len();
-        self.grasps[id.0 as usize] = grasp;
+        self.slot_mut(id)?.grasp = grasp;
         Ok(count)
     }
     /// Release tool `id`'s grasp: the tissue is free again (contact with the tool still acts).
     pub fn release(&mut self, id: ToolId) -> Result<(), Error> {
-        self.tool(id)?;
-        self.grasps[id.0 as usize] = Grasp::default();
+        self.slot_mut(id)?.grasp = Grasp::default();
         Ok(())
     }
     /// Number of particles tool `id` holds (0 when not grasping, or after the tissue slipped).
     pub fn grasped_count(&self, id: ToolId) -> Result<usize, Error> {
-        self.tool(id)?;
-        Ok(self.grasps[id.0 as usize].attachments.len())
+        Ok(self.slot(id)?.grasp.attachments.len())
     }
     /// Number of tools in the world (removed tools not counted).
     pub fn tool_count(&self) -> usize {
@@ -388,12 +401,19 @@ impl World {
     }
     /// A tool by id ([`Error::UnknownTool`] for an id never issued or removed).
     pub fn tool(&self, id: ToolId) -> Result<&Tool, Error> {
+        Ok(&self.slot(id)?.tool)
+    }
+    fn tool_mut(&mut self, id: ToolId) -> Result<&mut Tool, Error> {
+        Ok(&mut self.slot_mut(id)?.tool)
+    }
+    /// A tool's slot by id ([`Error::UnknownTool`] for an id never issued or removed).
+    fn slot(&self, id: ToolId) -> Result<&ToolSlot, Error> {
         self.tools
             .get(id.0 as usize)
             .and_then(Option::as_ref)
             .ok_or(Error::UnknownTool(id.0))
     }
-    fn tool_mut(&mut self, id: ToolId) -> Result<&mut Tool, Error> {
+    fn slot_mut(&mut self, id: ToolId) -> Result<&mut ToolSlot, Error> {
         self.tools
             .get_mut(id.0 as usize)
             .and_then(Option::as_mut)
@@ -490,7 +510,8 @@ impl World {
         let stable = (s.dt / (s.stability_margin * h_max)).ceil();
         let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
         let jump = self.tool_jump_distance();
-        for t in self.tools.iter().flatten().filter(|t| t.travel() <= jump) {
+        let tools = self.tools.iter().flatten().map(|s| &s.tool);
+        for t in tools.filter(|t| t.travel() <= jump) {
             let sweep = (t.travel() / radius).ceil();
             if sweep.is_finite() {
                 needed = needed.max(sweep.min(u32::MAX as Real) as u32);

@@ -121,8 +121,8 @@ impl World {
             }
         }
         let mut k = 0;
-        for ((tool, grasp), needle) in self.tools.iter().zip(&self.grasps).zip(&self.needles) {
-            let Some(tool) = tool else { continue };
+        for slot in self.tools.iter().flatten() {
+            let (tool, grasp, needle) = (&slot.tool, &slot.grasp, &slot.needle);
             let (pose, target, linear_velocity, wrench) =
                 (tool.pose, tool.target, tool.linear_velocity, tool.wrench);
             if k == out.tools.len() {
@@ -198,12 +198,9 @@ impl World {
                 .get(body as usize)
                 .is_some_and(|b| (particle as usize) < b.particle_count())
         };
-        let tools = self
-            .tools
-            .iter()
-            .zip(&self.needles)
-            .filter(|(t, _)| t.is_some());
-        for (k, (s, (_, needle))) in state.tools.iter().zip(tools).enumerate() {
+        let slots = self.tools.iter().flatten();
+        for (k, (s, slot)) in state.tools.iter().zip(slots).enumerate() {
+            let needle = &slot.needle;
             let finite = [s.pose, s.target].iter().all(|p| {
                 is_finite_vec(&p.position) && p.orientation.coords.iter().all(|c| c.is_finite())
             }) && [s.linear_velocity, s.wrench.force, s.wrench.torque]
@@ -260,14 +257,8 @@ impl World {
             }
             body.state.assign(&s.particles);
         }
-        let slots = self.grasps.iter_mut().zip(&mut self.needles);
-        let tools = self
-            .tools
-            .iter_mut()
-            .zip(slots)
-            .filter(|(t, _)| t.is_some());
-        for ((tool, (grasp, needle)), s) in tools.zip(&state.tools) {
-            let Some(tool) = tool else { continue };
+        for (slot, s) in self.tools.iter_mut().flatten().zip(&state.tools) {
+            let (tool, grasp, needle) = (&mut slot.tool, &mut slot.grasp, &mut slot.needle);
             (tool.pose, tool.target, tool.linear_velocity, tool.wrench) =
                 (s.pose, s.target, s.linear_velocity, s.wrench);
             grasp.attachments.clone_from(&s.grasp.attachments);

@@ -298,8 +298,6 @@ pub struct Tool {
     /// Linear velocity of the origin over the last step (m/s).
     pub(crate) linear_velocity: Vec3,
     pub(crate) wrench: Wrench,
-    /// What the interactions put on the tool in the step in progress.
-    pub(crate) load: ToolLoad,
 }
 
 /// What the interactions (contact, grasp, needle) put on a tool during a step, accumulated
@@ -387,7 +385,6 @@ impl Tool {
             sample_radius,
             linear_velocity: Vec3::zeros(),
             wrench: Wrench::default(),
-            load: ToolLoad::default(),
         })
     }
 

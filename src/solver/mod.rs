@@ -43,12 +43,11 @@ use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
 use crate::error::Error;
-use crate::grasp::Grasp;
 use crate::math::{Real, Vec3};
 use crate::parallel::SharedSlice;
 use crate::particles::{ParticleView, ParticleViews};
 use crate::settings::{ContactMode, MAX_THREADS};
-use crate::world::{StepReport, World};
+use crate::world::{StepReport, ToolSlot, World};
 use parry3d_f64::math::{Isometry, Point};
 
 /// The bodies' particle views over their step scratch, by body index.
@@ -81,16 +80,17 @@ impl World {
         // tissue it lands in leaves it at `max_depenetration_speed`. A blade does not push; it
         // cuts along its whole path, however fast.
         let jump = self.tool_jump_distance();
-        for (t, _) in (self.tools.iter_mut().zip(&self.blades)).filter(|(_, &blade)| !blade) {
-            if let Some(t) = t.as_mut().filter(|t| t.travel() > jump) {
+        for slot in self.tools.iter_mut().flatten().filter(|s| !s.blade) {
+            let t = &mut slot.tool;
+            if t.travel() > jump {
                 t.pose = t.target;
             }
         }
         let h = self.settings.dt / n as Real;
-        for t in self.tools.iter_mut().flatten() {
-            t.load.impulse = Vec3::zeros();
-            t.load.moment = Vec3::zeros();
-            t.load.penetration = 0.0;
+        for slot in self.tools.iter_mut().flatten() {
+            slot.load.impulse = Vec3::zeros();
+            slot.load.moment = Vec3::zeros();
+            slot.load.penetration = 0.0;
         }
         for k in 1..=n {
             self.substep(h, k, n);
@@ -122,12 +122,12 @@ impl World {
                 self.time
             )));
         }
-        for grasp in &mut self.grasps {
-            grasp.end_step(h, n);
+        for slot in self.tools.iter_mut().flatten() {
+            slot.grasp.end_step(h, n);
         }
         let mut cut = CutReport::default();
-        for (t, _) in self.tools.iter().zip(&self.blades).filter(|(_, &b)| b) {
-            let Some(t) = t else { continue };
+        for slot in self.tools.iter().flatten().filter(|s| s.blade) {
+            let t = &slot.tool;
             let half = match t.description {
                 ToolShape::Capsule { half_height, .. }
                 | ToolShape::Cylinder { half_height, .. } => half_height,
@@ -149,20 +149,21 @@ impl World {
             }
         }
         let dt = self.settings.dt;
-        for t in self.tools.iter_mut().flatten() {
+        for slot in self.tools.iter_mut().flatten() {
+            let (t, load) = (&mut slot.tool, &slot.load);
             let scale = -1.0 / (h * h * n as Real);
             t.wrench = Wrench {
-                force: t.load.impulse * scale,
-                torque: t.load.moment * scale,
-                contact_count: t.load.contacts,
-                max_penetration: t.load.penetration,
+                force: load.impulse * scale,
+                torque: load.moment * scale,
+                contact_count: load.contacts,
+                max_penetration: load.penetration,
             };
             t.linear_velocity = (t.target.position - t.pose.position) / dt;
             t.pose = t.target;
         }
-        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
-            if let (Some(tool), Some(needle)) = (tool, needle) {
-                needle.end_step(tool, &self.bodies);
+        for slot in self.tools.iter_mut().flatten() {
+            if let Some(needle) = &mut slot.needle {
+                needle.end_step(&slot.tool, &self.bodies);
             }
         }
         self.time += dt;
@@ -195,13 +196,16 @@ impl World {
                 .grid
                 .build(scratch.iter().map(|s| s.p.as_slice()), cell);
         }
-        for t in self.tools.iter_mut().flatten() {
-            t.load.contacts = 0;
+        for slot in self.tools.iter_mut().flatten() {
+            slot.load.contacts = 0;
         }
-        self.grasps.iter_mut().for_each(Grasp::begin_substep);
+        for slot in self.tools.iter_mut().flatten() {
+            slot.grasp.begin_substep();
+        }
         let s_cur = k as Real / n as Real;
-        for (tool, needle) in self.tools.iter().zip(&mut self.needles) {
-            if let (Some(tool), Some(needle)) = (tool, needle) {
+        for slot in self.tools.iter_mut().flatten() {
+            if let Some(needle) = &mut slot.needle {
+                let tool = &slot.tool;
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 let mut views = Views {
                     bodies: &self.bodies,
@@ -228,17 +232,14 @@ impl World {
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;
-            for (((tool, needle), &blade), grasp) in self
-                .tools
-                .iter_mut()
-                .zip(&self.needles)
-                .zip(&self.blades)
-                .zip(&self.grasps)
-            {
-                let Some(tool) = tool else { continue };
-                if blade {
-                    continue;
-                }
+            for slot in self.tools.iter_mut().flatten().filter(|s| !s.blade) {
+                let ToolSlot {
+                    tool,
+                    load,
+                    grasp,
+                    needle,
+                    ..
+                } = slot;
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 for (b, (body, scratch)) in self.bodies.iter().zip(scratch.iter_mut()).enumerate() {
@@ -250,6 +251,7 @@ impl World {
                         ContactMode::ExactShape => surface_contact::project_tool_surface(
                             &mut self.workspace.surface,
                             tool,
+                            load,
                             scratch.view(body),
                             &body.model.boundary,
                             motion,
@@ -259,6 +261,7 @@ impl World {
                         ),
                         ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
                             tool,
+                            load,
                             scratch.view(body),
                             motion,
                             max_correction,
@@ -267,26 +270,26 @@ impl World {
                     }
                 }
             }
-            for (tool, grasp) in self.tools.iter_mut().zip(&mut self.grasps) {
-                if let Some(tool) = tool {
-                    if !grasp.attachments.is_empty() {
-                        let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                        let mut views = Views {
-                            bodies: &self.bodies,
-                            scratch,
-                        };
-                        grasp.project(&mut views, &cur, &mut tool.load, h);
-                    }
-                }
-            }
-            for (tool, needle) in self.tools.iter_mut().zip(&mut self.needles) {
-                if let (Some(tool), Some(needle)) = (tool, needle) {
+            for slot in self.tools.iter_mut().flatten() {
+                if !slot.grasp.attachments.is_empty() {
+                    let tool = &slot.tool;
                     let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                     let mut views = Views {
                         bodies: &self.bodies,
                         scratch,
                     };
-                    needle.project(&mut views, &cur, &mut tool.load, h);
+                    slot.grasp.project(&mut views, &cur, &mut slot.load, h);
+                }
+            }
+            for slot in self.tools.iter_mut().flatten() {
+                if let Some(needle) = &mut slot.needle {
+                    let tool = &slot.tool;
+                    let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
+                    let mut views = Views {
+                        bodies: &self.bodies,
+                        scratch,
+                    };
+                    needle.project(&mut views, &cur, &mut slot.load, h);
                 }
             }
         }

@@ -8,7 +8,7 @@
 //! meets the samples only once it is out: the samples alone would push it out of each sample
 //! separately, in directions that fight, and a particle deep inside meets none of them.
 
-use crate::collision::tool::{Pose, Tool};
+use crate::collision::tool::{Pose, Tool, ToolLoad};
 use crate::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
@@ -22,7 +22,8 @@ use parry3d_f64::math::Point;
 /// tool's motion along it plus `max_correction` (m), and accumulate the tool's impulse and
 /// moment.
 pub(crate) fn project_sampled_contacts(
-    tool: &mut Tool,
+    tool: &Tool,
+    load: &mut ToolLoad,
     view: ParticleView<'_>,
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
@@ -46,11 +47,11 @@ pub(crate) fn project_sampled_contacts(
         let mut p = before;
         // The last contact point on the tool surface, where the impulse acts on the tool.
         let mut touched: Option<Vec3> = None;
-        let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3, tool: &mut Tool| {
+        let mut apply = |p: &mut Vec3, c: ContactProjection, contact: Vec3| {
             let tool_motion = tool_motion_at(&back, &contact);
             let rel = (*p - view.x[i]) - tool_motion;
             *p += friction_correction(&rel, &c.normal, c.correction, mu_s, mu_k);
-            tool.load.penetration = tool.load.penetration.max(c.depth);
+            load.penetration = load.penetration.max(c.depth);
             touched = Some(contact);
         };
         // The depenetration cap, as in the exact-shape mode: after a contact the particle moves
@@ -70,7 +71,7 @@ pub(crate) fn project_sampled_contacts(
             let away = (p - centre).try_normalize(1e-12).unwrap_or(Vec3::y());
             let q = p;
             let c = push_out_of_solid(&mut p, &on_tool, &away, r, &|n| cap(&q, n, &on_tool));
-            apply(&mut p, c, on_tool, tool);
+            apply(&mut p, c, on_tool);
         }
         if !surface.is_inside || !tool.shape.contains_point(&iso, &Point::from(p)) {
             let rs = tool.sample_radius;
@@ -80,16 +81,16 @@ pub(crate) fn project_sampled_contacts(
                 let limit = |n: &Vec3| cap(&q, n, &(sw + n * rs));
                 if let Some(c) = project_point_sphere(&mut p, &sw, r + rs, limit) {
                     let contact = sw + c.normal * rs;
-                    apply(&mut p, c, contact, tool);
+                    apply(&mut p, c, contact);
                 }
             }
         }
         if let Some(contact) = touched {
             let impulse = (p - before) * view.mass[i];
-            tool.load.impulse += impulse;
-            tool.load.moment += (contact - centre).cross(&impulse);
+            load.impulse += impulse;
+            load.moment += (contact - centre).cross(&impulse);
             if count {
-                tool.load.contacts += 1;
+                load.contacts += 1;
             }
             view.p[i] = p;
         }

@@ -30,7 +30,7 @@
 //!   far side, on the line along `n` through the foot of the tool's middle, is `r` in front of it;
 //! - otherwise (a tool inside the body, e.g. after a teleport) the minimal separation.
 
-use crate::collision::tool::{Pose, Tool, ToolShape};
+use crate::collision::tool::{Pose, Tool, ToolLoad, ToolShape};
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
 use crate::parallel::{Pool, SharedSlice};
@@ -132,7 +132,8 @@ impl std::fmt::Debug for SurfaceScratch {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_tool_surface(
     surface: &mut SurfaceScratch,
-    tool: &mut Tool,
+    tool: &Tool,
+    load: &mut ToolLoad,
     view: ParticleView<'_>,
     boundary: &[[u32; 3]],
     (prev, cur): (&Pose, &Pose),
@@ -264,11 +265,11 @@ pub(crate) fn project_tool_surface(
                 view.p[corners[k]] += dp;
                 impulse += dp * view.mass[corners[k]];
             }
-            tool.load.impulse += impulse;
-            tool.load.moment += (contact.point - cur.position).cross(&impulse);
-            tool.load.penetration = tool.load.penetration.max(depth);
+            load.impulse += impulse;
+            load.moment += (contact.point - cur.position).cross(&impulse);
+            load.penetration = load.penetration.max(depth);
             if count && pass == 0 {
-                tool.load.contacts += 1;
+                load.contacts += 1;
             }
         }
         if largest <= SURFACE_PASS_TOLERANCE * skin {
