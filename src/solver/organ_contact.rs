@@ -5,8 +5,13 @@ use crate::body::Body;
 use crate::collision::hash_grid::HashGrid;
 use crate::constraints::contact::project_particle_particle;
 use crate::constraints::friction::friction_correction;
+use crate::math::{Real, Vec3};
 use crate::solver::StepScratch;
 use crate::world::PairFriction;
+
+/// Bodies up to which the organ contact pass skips particles far from every other body (a
+/// fixed-size array: the step allocates nothing).
+const BOUNDED_BODIES: usize = 16;
 
 /// One Gauss–Seidel pass over the particle–particle contacts between bodies (and within a body
 /// when `self_contact`), found through `grid` (built on the predicted positions, in `scratch`), with the
@@ -19,9 +24,41 @@ pub(crate) fn project_organ_contacts(
     self_contact: bool,
 ) {
     let nb = bodies.len();
+    // Without self-contact only particles near another body can touch: each body's bounding
+    // box of its predicted positions, grown by every write of the pass (so it always holds
+    // them all), lets a particle farther than the contact distance from every other body's box
+    // skip the grid query. It skips only pairs that cannot touch: the same projections in the
+    // same order, the same bits. Up to `BOUNDED_BODIES` bodies (no allocation in a step); more
+    // bodies query every particle.
+    let mut bounds = [(
+        Vec3::repeat(Real::INFINITY),
+        Vec3::repeat(Real::NEG_INFINITY),
+    ); BOUNDED_BODIES];
+    let bounded = !self_contact && nb <= BOUNDED_BODIES;
+    if bounded {
+        for (b, s) in scratch.iter().enumerate() {
+            bounds[b] =
+                s.p.iter()
+                    .fold(bounds[b], |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+        }
+    }
+    let reach = bodies
+        .iter()
+        .map(|b| b.model.particle_radius)
+        .fold(0.0, Real::max);
     for a in 0..nb {
+        let ra = bodies[a].model.particle_radius;
         for i in 0..bodies[a].particle_count() {
             let pi = scratch[a].p[i];
+            if bounded
+                && (0..nb).all(|b| {
+                    let (lo, hi) = bounds[b];
+                    let margin = Vec3::repeat(ra + reach);
+                    b == a || (pi - (lo - margin)).min() < 0.0 || ((hi + margin) - pi).min() < 0.0
+                })
+            {
+                continue;
+            }
             let friction = pair_friction;
             grid.for_each_near(&pi, |[b, j]| {
                 let (b, j) = (b as usize, j as usize);
@@ -52,6 +89,11 @@ pub(crate) fn project_organ_contacts(
                 }
                 scratch[a].p[i] = pa;
                 scratch[b].p[j] = pb;
+                if bounded {
+                    for (k, p) in [(a, pa), (b, pb)] {
+                        bounds[k] = (bounds[k].0.inf(&p), bounds[k].1.sup(&p));
+                    }
+                }
             });
         }
     }
