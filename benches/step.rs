@@ -1,4 +1,4 @@
-//! Step timing of the DESIGN §7 haptic scene on the test livers (data/meshes): ms per step (median, p99,
+//! Step timing of the haptic scene on the test livers (data/meshes): ms per step (median, p99,
 //! max, mean), cost per particle, memory per particle; with and without a probe in contact.
 //!
 //! ```text
@@ -9,7 +9,7 @@
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
-//! - `haptic` (DESIGN §7): mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
+//! - `haptic`: mesh scaled by 0.03 (~0.2 m), E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³,
 //!   dt = 1 ms, top 10% of the y range fixed, gravity;
 //! - `pypbd` (the peer script `validation/peers/pypbd_liver.py`): mesh units, E = 3000, ν = 0.45,
 //!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.

@@ -1,5 +1,5 @@
-//! Evidence for issue #6 (accuracy against FEM, the paper's experiments) and issue #3 (the probe
-//! force trace). Each subcommand runs scenes and writes CSV files that `validation/accuracy.py`
+//! Evidence for docs/history/VALIDATION_HISTORY.md: accuracy against FEM, the paper's experiments and the probe
+//! force trace. Each subcommand runs scenes and writes CSV files that `validation/accuracy.py`
 //! and `validation/paper_experiments.py` turn into tables and plots (see docs/VALIDATION.md).
 //!
 //! ```text
@@ -9,7 +9,7 @@
 //! cargo run --release --example evidence -- volume --out CSV         # paper Fig. 6
 //! cargo run --release --example evidence -- runtime --out CSV        # paper Fig. 7
 //! cargo run --release --example evidence -- large --out DIR          # paper Fig. 9 (+ VTU into DIR/vtu)
-//! cargo run --release --example evidence -- press --out CSV          # issue #3 probe force trace
+//! cargo run --release --example evidence -- press --out CSV  # probe force trace
 //! ```
 //! Meshes are read from the repository's `data/meshes`, or from `$TISSUESIM_MESHES` when set.
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Speed: tissuesim against Bender's PositionBasedDynamics (pypbd) on the same meshes, scene and
-# dt, in one run (each on one thread and on two); then tissuesim alone on the DESIGN §7 haptic
+# dt, in one run (each on one thread and on two); then tissuesim alone on the haptic
 # scene with and without a probe (the four livers and the three-organ scene), the speed-up of two
 # threads over one with the serial share it implies (Amdahl) and its projection to 4-16 threads.
 #
@@ -51,7 +51,7 @@ for mesh in "${LIST[@]}"; do
 done
 
 echo
-echo "DESIGN §7 haptic scene (SI, dt = 1 ms), 1 and 2 threads:"
+echo "Haptic scene (SI, dt = 1 ms), 1 and 2 threads:"
 for t in 1 2; do
   cargo bench -q --bench step -- --scene haptic --meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs --steps "$STEPS" --threads "$t" --csv "$TMP/h$t.csv" --times "$TMP/times$t.csv"
 done

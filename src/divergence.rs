@@ -1,6 +1,7 @@
 //! The per-step divergence check: a body whose particles became non-finite, or left the
 //! physical bounds of [`DivergenceLimits`] (a finite explosion), makes the step fail and be
-//! rolled back. O(particles + tetrahedra) per body.
+//! rolled back. O(particles + boundary triangles) per body (the volume is that the boundary
+//! encloses).
 //!
 //! The extent and volume bounds fail a step only when it moves the body farther out of them
 //! than it was at the start of the step (`before`, its positions then): a body set into an inverted or

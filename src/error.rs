@@ -24,7 +24,9 @@ pub enum Error {
     UnknownRenderSurface(u32),
     /// A saved state cannot be restored into this world (version, size or scene mismatch).
     BadState(String),
-    /// A step produced NaN or Inf; the world was rolled back to its state before the step.
+    /// A step produced NaN or Inf, or left the physical bounds of
+    /// [`DivergenceLimits`](crate::DivergenceLimits) (speed, extent, volume ratio); the world was
+    /// rolled back to its state before the step, and the message names the body and the reason.
     Diverged(String),
 }
 

@@ -25,6 +25,14 @@ use tissuesim::{
     ToolOptions, ToolShape, Vec3, World,
 };
 
+/// What `--help` prints (stdout, exit 0) and an unknown argument shows (stderr, exit 2).
+const USAGE: &str = "usage: tissuesim [--out DIR] [--every K] [--no-settle]
+  Settles the default organ, then presses a probe, grasps and lifts, and cuts it, printing the
+  tool forces (N) as it runs.
+  --out DIR     where the VTU/OBJ frames go (default: out)
+  --every K     write a frame every K steps of 1 ms (default: 25)
+  --no-settle   start from the rest shape instead of the static equilibrium under gravity";
+
 struct Args {
     settle: bool,
     out: PathBuf,
@@ -45,9 +53,10 @@ fn parse_args() -> Result<Args, String> {
             "--every" => args.every = value("--every")?.parse().map_err(|e| format!("{e}"))?,
             "--out" => args.out = PathBuf::from(value("--out")?),
             "-h" | "--help" => {
-                return Err("usage: tissuesim [--out DIR] [--every K] [--no-settle]".into())
+                println!("{USAGE}");
+                std::process::exit(0);
             }
-            other => return Err(format!("unknown argument {other}")),
+            other => return Err(format!("unknown argument {other}\n{USAGE}")),
         }
     }
     if args.every == 0 {

@@ -44,8 +44,8 @@ pub struct Settings {
     /// equilibria and contact forces at rest are unchanged; the added mass is reported by
     /// [`Body::added_mass`](crate::Body::added_mass).
     pub mass_scaling: bool,
-    /// Mass-proportional (ambient) damping rate α (1/s): each substep scales particle velocities
-    /// by `1/(1 + α·dt)`. Models the viscous surroundings of an organ; damps rigid motion too.
+    /// Mass-proportional (ambient) damping rate α (1/s): each substep of length `h` (s) scales
+    /// particle velocities by `1/(1 + α·h)`. Models the viscous surroundings of an organ; damps rigid motion too.
     pub damping_mass: Real,
     /// Stiffness-proportional damping time β (s): a dashpot on each neighbour pair with
     /// coefficient β·k_ij (k_ij the pair's elastic stiffness, N/m), acting along the pair.
@@ -53,7 +53,7 @@ pub struct Settings {
     pub damping_stiffness: Real,
     /// Hourglass-control stiffness (dimensionless, multiplies the shear modulus μ): penalises
     /// the part of each pair's deformation that the particle's deformation gradient does not
-    /// explain (Ganzenmüller 2015), which suppresses the zero-energy modes of nodal
+    /// explain (in the spirit of Ganzenmüller 2015; the form in `crate::elastic`), which suppresses the zero-energy modes of nodal
     /// integration. Zero for every affine motion, so it never affects the patch test. The
     /// default 0.25 comes from the static study of docs/VALIDATION.md: with the volume
     /// constraints on, the worst error against FEM over two livers and a beam is flat for
@@ -107,7 +107,7 @@ pub struct Settings {
 
 /// Bounds beyond which a step counts as diverged (a finite explosion: the solver gained
 /// energy, the tissue turned inside out or flew apart), checked on every body after every
-/// step in O(particles + tetrahedra). Each is relative to the body's rest size (the diagonal
+/// step in O(particles + boundary triangles). Each is relative to the body's rest size (the diagonal
 /// of its rest bounding box), so one setting fits a 2 cm lobe and a 30 cm liver; set a field
 /// to infinity (or the volume range to (0, ∞)) to switch that check off. The extent and volume
 /// bounds fail a step only when it moves the body farther out of them, so that a body set into

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Accuracy of the point-based solver against the scikit-fem references (issue #6 item 1).
+"""Accuracy of the point-based solver against the scikit-fem references
+(the figures of docs/history/VALIDATION_HISTORY.md §1).
 
     build/venv-validation/bin/python validation/accuracy.py [--runs build/evidence/accuracy]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots and tables of the paper's experiments (issue #6 item 2) and of the probe force trace (issue #3).
+"""Plots and tables of the paper's experiments (Fig. 6, 7, 9) and of the probe force trace.
 
     build/venv-validation/bin/python validation/paper_experiments.py [--large build/evidence/large]
 
@@ -8,7 +8,7 @@ Reads what `cargo run --release --example evidence -- {volume,runtime,large,pres
   docs/data/runtime.csv            -> docs/img/runtime.png                                      (paper Fig. 7)
   build/evidence/large/*.csv,
   docs/data/large_deformation.csv  -> docs/img/large_<scenario>.png, docs/img/large_trace.png   (paper Fig. 9)
-  docs/data/press_trace.csv        -> docs/img/press_trace.png                                  (issue #3)
+  docs/data/press_trace.csv        -> docs/img/press_trace.png
 and prints the tables used in docs/VALIDATION.md. Parts whose input is missing are skipped with a note.
 """
 import argparse

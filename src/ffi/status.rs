@@ -86,7 +86,7 @@ impl ts_status {
             }
             ts_status::BadState => "TS_STATUS_BAD_STATE: the saved state cannot be restored\0",
             ts_status::Diverged => {
-                "TS_STATUS_DIVERGED: the step produced NaN/Inf and was rolled back\0"
+                "TS_STATUS_DIVERGED: the step produced NaN/Inf or left the divergence limits and was rolled back\0"
             }
             ts_status::IoError => "TS_STATUS_IO_ERROR: input/output error\0",
             ts_status::Panic => "TS_STATUS_PANIC: internal error (a Rust panic was caught)\0",
