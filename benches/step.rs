@@ -5,7 +5,7 @@
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
-//!                             [--times PATH]
+//!                             [--times PATH] [--dual-cells]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -15,7 +15,8 @@
 //!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
-//! by 15% of its size. `--threads` sets `Settings::threads` (default 1).
+//! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
+//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron.
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -27,7 +28,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+    mesh, BodyId, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3,
+    VolumeScheme, World,
 };
 
 /// Counts live heap bytes, for memory per particle.
@@ -199,10 +201,17 @@ fn add_organs(world: &mut World, name: &str, scene: Scene) -> (Vec<BodyId>, Vec3
     (vec![a, b, c], lo, hi)
 }
 
-fn run(name: &str, scene: Scene, probe: bool, steps: usize, threads: u32) -> Row {
+fn run(
+    name: &str,
+    scene: Scene,
+    probe: bool,
+    steps: usize,
+    (threads, volume_scheme): (u32, VolumeScheme),
+) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let settings = Settings {
         threads,
+        volume_scheme,
         ..Settings::default()
     };
     let mut world = World::new(settings).unwrap();
@@ -298,6 +307,7 @@ fn main() {
     let mut times_csv: Option<PathBuf> = None;
     let mut scene_name = "haptic".to_string();
     let mut threads = 1;
+    let mut volume_scheme = VolumeScheme::Tetrahedra;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -314,6 +324,7 @@ fn main() {
             "--times" => times_csv = Some(PathBuf::from(args.next().expect("--times PATH"))),
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
+            "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -339,7 +350,13 @@ fn main() {
     let mut series = String::from("scene,threads,mesh,probe,step,ms\n");
     for m in &meshes {
         for probe in [false, true] {
-            let r = run(m, scene(&scene_name), probe, steps, threads);
+            let r = run(
+                m,
+                scene(&scene_name),
+                probe,
+                steps,
+                (threads, volume_scheme),
+            );
             let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
             let bpp = r.bytes as f64 / r.particles as f64;
             println!(

@@ -311,6 +311,8 @@ pub struct Body {
     pub(crate) volume_compliance: Real,
     /// Whether the world projects the volume constraints (`Settings::volume_constraints`).
     pub(crate) volume_constraints_on: bool,
+    /// What each volume constraint keeps (`Settings::volume_scheme`).
+    pub(crate) volume_scheme: crate::VolumeScheme,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
 }
@@ -335,6 +337,7 @@ impl Body {
             omega_max: 0.0,
             volume_compliance: 0.0,
             volume_constraints_on: false,
+            volume_scheme: crate::VolumeScheme::Tetrahedra,
             model,
         };
         body.configure(settings);
@@ -532,6 +535,7 @@ impl Body {
         );
         self.volume_compliance = settings.volume_compliance;
         self.volume_constraints_on = settings.volume_constraints;
+        self.volume_scheme = settings.volume_scheme;
         if settings.volume_constraints && settings.volumetric_split {
             self.volume_compliance += 1.0 / self.elastic.lambda;
             self.elastic.lambda = 0.0;

@@ -13,6 +13,7 @@
 use crate::body::BodyOptions;
 use crate::colouring::TetColouring;
 use crate::consistency;
+use crate::dual_cells::DualCells;
 use crate::error::Error;
 use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::mesh::TetMesh;
@@ -47,6 +48,8 @@ pub struct BodyModel {
     pub(crate) rest_volume: Real,
     /// The tetrahedra grouped into colours that share no particle, for the volume pass.
     pub(crate) tet_colouring: TetColouring,
+    /// The particles' dual cells, for volume constraints per particle.
+    pub(crate) dual_cells: DualCells,
     /// Which mesh node each particle is: every array above is in particle order.
     pub(crate) order: ParticleOrder,
 }
@@ -120,6 +123,7 @@ impl BodyModel {
         let density = options.material.density;
         let (lo, hi) = mesh.bounding_box();
         let tet_colouring = TetColouring::new(&mesh.tets, &tet_rest_volume, n);
+        let dual_cells = DualCells::new(&mesh.tets, &tet_rest_volume, n);
         Ok(Arc::new(BodyModel {
             options: options.clone(),
             rest: mesh.nodes.clone(),
@@ -136,6 +140,7 @@ impl BodyModel {
             rest_centre: (lo + hi) * 0.5,
             size: (hi - lo).norm(),
             tet_colouring,
+            dual_cells,
             order,
         }))
     }
@@ -203,6 +208,7 @@ impl BodyModel {
             + size_of_val(n.incoming.as_slice())
             + size_of_val(n.sources.as_slice())
             + self.tet_colouring.heap_bytes()
+            + self.dual_cells.heap_bytes()
             + 2 * size_of_val(self.order.mesh_indices())
     }
 }

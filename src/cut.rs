@@ -24,6 +24,7 @@
 use crate::body::Body;
 use crate::body_model::BodyModel;
 use crate::colouring::TetColouring;
+use crate::dual_cells::DualCells;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::Neighbourhoods;
@@ -236,6 +237,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
     }
     model.rest_volume = model.tet_rest_volume.iter().sum();
     model.tet_colouring = TetColouring::new(&model.tets, &model.tet_rest_volume, n);
+    model.dual_cells = DualCells::new(&model.tets, &model.tet_rest_volume, n);
     let mesh = TetMesh {
         nodes: model.rest.clone(),
         tets: model.tets.clone(),

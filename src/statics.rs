@@ -13,12 +13,13 @@
 //!
 //! The energy is the one the step integrates: the point-based corotated elasticity
 //! `Σ_i v_i Ψ(F_i)`, the hourglass term, and — when the volume constraints carry the
-//! volumetric stiffness — each tetrahedron's `(V − V₀)² / (2 α V₀)` with `α` the constraints'
-//! compliance per unit volume (1/Pa). Tools and organ–organ contacts are not part of it.
+//! volumetric stiffness — each constraint's `(V − V₀)² / (2 α V₀)` (a tetrahedron's or a
+//! particle's dual cell's volume) with `α` the constraints' compliance per unit volume (1/Pa). Tools and organ–organ contacts are not part of it.
 
 use crate::body::Body;
 use crate::error::Error;
 use crate::math::{Mat3, Real, Vec3};
+use crate::settings::VolumeScheme;
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
@@ -93,17 +94,23 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
         })
         .collect();
     let volume_stiffness = volume_stiffness_per_unit_volume(body);
-    let tets: Vec<Vec<u32>> = if volume_stiffness > 0.0 {
-        body.model.tets.iter().map(|t| t.to_vec()).collect()
-    } else {
-        Vec::new()
-    };
+    // Each volume term's particles, and the term's gradients at `at` (Gauss–Newton).
+    let mut volume_terms: Vec<(Real, Vec<(u32, Vec3)>)> = Vec::new();
+    if volume_stiffness > 0.0 {
+        for_each_volume_term(body, at.unwrap_or(&body.model.rest), |v0, _, g| {
+            volume_terms.push((v0, g.to_vec()))
+        });
+    }
+    let volume_stencils: Vec<Vec<u32>> = volume_terms
+        .iter()
+        .map(|(_, g)| g.iter().map(|(k, _)| *k).collect())
+        .collect();
     let mut k = BlockMatrix::from_stencils(
         n,
         stencils
             .iter()
             .map(Vec::as_slice)
-            .chain(tets.iter().map(Vec::as_slice)),
+            .chain(volume_stencils.iter().map(Vec::as_slice)),
     );
     let (lambda, mu, hourglass) = (body.elastic.lambda, body.elastic.mu, body.elastic.hourglass);
     let mut c = Vec::new();
@@ -157,22 +164,58 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
             }
         }
     }
-    if volume_stiffness > 0.0 {
-        for (t, tet) in body.model.tets.iter().enumerate() {
-            let g = volume_gradient(at.unwrap_or(&body.model.rest), tet);
-            let kt = volume_stiffness / body.model.tet_rest_volume[t];
-            for p in 0..4 {
-                for q in 0..4 {
-                    k.add(tet[p], tet[q], &(g[p] * g[q].transpose() * kt));
-                }
+    for (v0, g) in &volume_terms {
+        let kt = volume_stiffness / v0;
+        for (p, gp) in g {
+            for (q, gq) in g {
+                k.add(*p, *q, &(gp * gq.transpose() * kt));
             }
         }
     }
     k
 }
 
-/// Stiffness per unit volume (Pa) of the tetrahedron volume constraints, `1/α`; 0 when they
-/// are off or infinitely compliant.
+/// Calls `f(v0, v, gradient)` for each volume constraint of `body` at positions `x` (m): its
+/// rest volume (m³), its volume (m³), and the volume's gradient (m²) with respect to each
+/// particle it depends on. One term per tetrahedron or per particle's dual cell
+/// (`Settings::volume_scheme`); a dual cell emptied by a cut has none.
+fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &[(u32, Vec3)])) {
+    let model = &body.model;
+    let mut gradient = Vec::new();
+    match body.volume_scheme {
+        VolumeScheme::Tetrahedra => {
+            for (t, tet) in model.tets.iter().enumerate() {
+                gradient.clear();
+                gradient.extend(tet.iter().copied().zip(volume_gradient(x, tet)));
+                let [a, b, c, d] = tet.map(|k| x[k as usize]);
+                let v = crate::math::tet_volume(&a, &b, &c, &d);
+                f(model.tet_rest_volume[t], v, &gradient);
+            }
+        }
+        VolumeScheme::DualCells => {
+            let cells = &model.dual_cells;
+            let mut cell_gradient = Vec::new();
+            for i in 0..cells.len() {
+                let v0 = cells.rest_volume(i);
+                if v0 > 0.0 {
+                    let v = cells.volume_and_gradient(i, &model.tets, x, &mut cell_gradient);
+                    gradient.clear();
+                    gradient.extend(
+                        cells
+                            .star(i)
+                            .iter()
+                            .copied()
+                            .zip(cell_gradient.iter().copied()),
+                    );
+                    f(v0, v, &gradient);
+                }
+            }
+        }
+    }
+}
+
+/// Stiffness per unit volume (Pa) of the volume constraints, `1/α`; 0 when they are off or
+/// infinitely compliant.
 fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
     let alpha = body.volume_compliance;
     if body.volume_constraints_on && alpha.is_finite() && alpha > 0.0 {
@@ -198,12 +241,9 @@ fn energy(body: &Body, x: &[Vec3], g: Vec3) -> Real {
     let mut e = crate::elastic::energy(&body.elastic, &model.nbr, &model.particle_volume, x);
     let stiffness = volume_stiffness_per_unit_volume(body);
     if stiffness > 0.0 {
-        for (t, tet) in model.tets.iter().enumerate() {
-            let v0 = model.tet_rest_volume[t];
-            let [a, b, c, d] = tet.map(|k| x[k as usize]);
-            let violation = crate::math::tet_volume(&a, &b, &c, &d) - v0;
-            e += 0.5 * stiffness * violation * violation / v0;
-        }
+        for_each_volume_term(body, x, |v0, v, _| {
+            e += 0.5 * stiffness * (v - v0) * (v - v0) / v0
+        });
     }
     for ((x, m), fixed) in x.iter().zip(&model.mass).zip(&body.fixed) {
         if !fixed {
@@ -219,16 +259,12 @@ fn add_volume_forces(body: &Body, x: &[Vec3], force: &mut [Vec3]) {
     if stiffness == 0.0 {
         return;
     }
-    for (t, tet) in body.model.tets.iter().enumerate() {
-        let v0 = body.model.tet_rest_volume[t];
-        let g = volume_gradient(x, tet);
-        let [a, b, c, d] = tet.map(|k| x[k as usize]);
-        let violation = crate::math::tet_volume(&a, &b, &c, &d) - v0;
-        let scale = -stiffness * violation / v0;
-        for p in 0..4 {
-            force[tet[p] as usize] += g[p] * scale;
+    for_each_volume_term(body, x, |v0, v, gradient| {
+        let scale = -stiffness * (v - v0) / v0;
+        for (k, g) in gradient {
+            force[*k as usize] += g * scale;
         }
-    }
+    });
 }
 
 /// The rest stiffness restricted to the free particles, factorised.

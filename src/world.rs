@@ -125,6 +125,7 @@ impl World {
         let bodies_affected = settings.hourglass_stiffness != s.hourglass_stiffness
             || settings.volume_constraints != s.volume_constraints
             || settings.volumetric_split != s.volumetric_split
+            || settings.volume_scheme != s.volume_scheme
             || settings.volume_compliance != s.volume_compliance
             || settings.damping_stiffness != s.damping_stiffness
             || settings.mass_scaling != s.mass_scaling

@@ -7,7 +7,7 @@ mod common;
 use common::two_bodies_stacked;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3};
+use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3, VolumeScheme};
 
 struct Counting;
 
@@ -45,14 +45,16 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 
 #[test]
 fn steps_after_the_first_do_not_allocate() {
-    for (mode, threads) in [
-        (ContactMode::ExactShape, 1),
-        (ContactMode::SampledPoints, 1),
-        (ContactMode::ExactShape, 2),
+    for (mode, threads, volume_scheme) in [
+        (ContactMode::ExactShape, 1, VolumeScheme::Tetrahedra),
+        (ContactMode::SampledPoints, 1, VolumeScheme::Tetrahedra),
+        (ContactMode::ExactShape, 2, VolumeScheme::Tetrahedra),
+        (ContactMode::ExactShape, 1, VolumeScheme::DualCells),
     ] {
         let settings = Settings {
             contact_mode: mode,
             threads,
+            volume_scheme,
             ..Settings::default()
         };
         let (mut world, a, b) = two_bodies_stacked(settings);

@@ -46,7 +46,7 @@ use crate::error::Error;
 use crate::math::{Real, Vec3};
 use crate::parallel::SharedSlice;
 use crate::particles::{ParticleView, ParticleViews};
-use crate::settings::{ContactMode, MAX_THREADS};
+use crate::settings::{ContactMode, VolumeScheme, MAX_THREADS};
 use crate::world::{StepReport, ToolSlot, World};
 use parry3d_f64::math::{Isometry, Point};
 
@@ -218,7 +218,12 @@ impl World {
         for it in 0..self.settings.iterations {
             if self.settings.volume_constraints {
                 for (body, scratch) in self.bodies.iter().zip(scratch.iter_mut()) {
-                    volume::project_volumes(body, scratch, h, &self.pool);
+                    match body.volume_scheme {
+                        VolumeScheme::Tetrahedra => {
+                            volume::project_volumes(body, scratch, h, &self.pool)
+                        }
+                        VolumeScheme::DualCells => volume::project_dual_cells(body, scratch, h),
+                    }
                 }
             }
             if organ_contact {

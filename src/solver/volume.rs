@@ -134,6 +134,50 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
     });
 }
 
+/// One Gauss–Seidel pass over a body's dual-cell volume constraints for a substep `h` (s), on
+/// its predicted positions in `scratch`, particle by particle in order on the calling thread
+/// (the same bits for any thread count). Particle `i`'s constraint `C_i = V_i(x) − V_i⁰` (its
+/// cell's volume against its rest volume, m³) has the XPBD compliance of the body's compliance
+/// per unit volume (1/Pa) times `V_i⁰`, divided by h²; its correction moves every particle of
+/// the cell's tetrahedra.
+pub(crate) fn project_dual_cells(body: &Body, scratch: &mut StepScratch, h: Real) {
+    if !body.volume_compliance.is_finite() {
+        return;
+    }
+    let compliance_per_h2 = body.volume_compliance / (h * h);
+    let model = &body.model;
+    let cells = &model.dual_cells;
+    let StepScratch {
+        p,
+        tet_lambda,
+        cell_gradient,
+        ..
+    } = scratch;
+    for (i, lambda) in tet_lambda[..cells.len()].iter_mut().enumerate() {
+        let v0 = cells.rest_volume(i);
+        if v0 <= 0.0 {
+            continue;
+        }
+        let v = cells.volume_and_gradient(i, &model.tets, p, cell_gradient);
+        let star = cells.star(i);
+        let alpha = compliance_per_h2 * v0;
+        let weight: Real = star
+            .iter()
+            .zip(cell_gradient.iter())
+            .map(|(k, g)| body.inv_mass[*k as usize] * g.norm_squared())
+            .sum();
+        let denominator = weight + alpha;
+        if denominator <= 0.0 {
+            continue;
+        }
+        let dl = (-(v - v0) - alpha * *lambda) / denominator;
+        *lambda += dl;
+        for (k, g) in star.iter().zip(cell_gradient.iter()) {
+            p[*k as usize] += g * (body.inv_mass[*k as usize] * dl);
+        }
+    }
+}
+
 /// `[f(0), f(1), f(2), f(3)]`, always inlined (`array::map` and `from_fn` are not always, in a
 /// loop this hot).
 #[inline(always)]

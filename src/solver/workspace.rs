@@ -25,9 +25,13 @@ pub(crate) struct StepScratch {
     /// The particles' sums of their pair forces (N), kept as `pair_force` is (one entry per
     /// particle; empty on one thread).
     pub(crate) own_force: Vec<Vec3>,
-    /// XPBD multipliers of the volume constraints within a substep, one per load-time
-    /// tetrahedron, in the colouring's projection order (a cut body uses the first ones).
+    /// XPBD multipliers of the volume constraints within a substep: one per load-time
+    /// tetrahedron, in the colouring's projection order (a cut body uses the first ones), or
+    /// one per particle for dual cells (the array holds the larger count).
     pub(crate) tet_lambda: Vec<Real>,
+    /// A dual cell's volume gradient with respect to each particle of its star (m²), for the
+    /// projection of one cell; capacity the model's largest star, so it never grows in a step.
+    pub(crate) cell_gradient: Vec<Vec3>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
 }
@@ -41,7 +45,8 @@ impl StepScratch {
             force: vec![Vec3::zeros(); n],
             pair_force: Vec::new(),
             own_force: Vec::new(),
-            tet_lambda: vec![0.0; model.tets.len()],
+            tet_lambda: vec![0.0; model.tets.len().max(n)],
+            cell_gradient: Vec::with_capacity(model.dual_cells.max_star()),
             scan: ParticleScan::EMPTY,
         };
         scratch.size_kept(model, threads);
