@@ -1,4 +1,4 @@
-//! `Settings`, `DivergenceLimits` and `ContactMode`: the world's parameters, every field as in
+//! `Settings`, `DivergenceLimits`, `ContactMode` and `VolumeScheme`: the world's parameters, every field as in
 //! the Rust `tissuesim::Settings` (SI units; see the `.pyi` stub for each field's unit).
 
 use pyo3::prelude::*;
@@ -29,6 +29,34 @@ impl From<tissuesim::ContactMode> for ContactMode {
         match m {
             tissuesim::ContactMode::ExactShape => ContactMode::ExactShape,
             tissuesim::ContactMode::SampledPoints => ContactMode::SampledPoints,
+        }
+    }
+}
+
+/// What one volume constraint keeps.
+#[pyclass(module = "tissuesim", eq, eq_int, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum VolumeScheme {
+    /// One constraint per tetrahedron (the paper's; the default).
+    Tetrahedra,
+    /// One constraint per particle on its dual cell: does not lock as nu -> 0.5.
+    DualCells,
+}
+
+impl From<VolumeScheme> for tissuesim::VolumeScheme {
+    fn from(m: VolumeScheme) -> Self {
+        match m {
+            VolumeScheme::Tetrahedra => tissuesim::VolumeScheme::Tetrahedra,
+            VolumeScheme::DualCells => tissuesim::VolumeScheme::DualCells,
+        }
+    }
+}
+
+impl From<tissuesim::VolumeScheme> for VolumeScheme {
+    fn from(m: tissuesim::VolumeScheme) -> Self {
+        match m {
+            tissuesim::VolumeScheme::Tetrahedra => VolumeScheme::Tetrahedra,
+            tissuesim::VolumeScheme::DualCells => VolumeScheme::DualCells,
         }
     }
 }
@@ -114,6 +142,8 @@ pub struct Settings {
     pub volume_constraints: bool,
     /// With volume constraints: lambda carried by them (compliance 1/lambda). Default True.
     pub volumetric_split: bool,
+    /// What each volume constraint keeps. Default VolumeScheme.Tetrahedra.
+    pub volume_scheme: VolumeScheme,
     /// Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0.
     pub volume_compliance: Real,
     /// Gauss-Seidel iterations over all constraints per substep. Default 1.
@@ -146,6 +176,7 @@ impl Settings {
             hourglass_stiffness: self.hourglass_stiffness,
             volume_constraints: self.volume_constraints,
             volumetric_split: self.volumetric_split,
+            volume_scheme: self.volume_scheme.into(),
             volume_compliance: self.volume_compliance,
             iterations: self.iterations,
             contact_mode: self.contact_mode.into(),
@@ -169,6 +200,7 @@ impl Settings {
             hourglass_stiffness: s.hourglass_stiffness,
             volume_constraints: s.volume_constraints,
             volumetric_split: s.volumetric_split,
+            volume_scheme: s.volume_scheme.into(),
             volume_compliance: s.volume_compliance,
             iterations: s.iterations,
             contact_mode: s.contact_mode.into(),
@@ -203,6 +235,7 @@ impl Settings {
                 hourglass_stiffness,
                 volume_constraints,
                 volumetric_split,
+                volume_scheme,
                 volume_compliance,
                 iterations,
                 contact_mode,
@@ -236,6 +269,7 @@ impl Settings {
                 hourglass_stiffness,
                 volume_constraints,
                 volumetric_split,
+                volume_scheme,
                 volume_compliance,
                 iterations,
                 contact_mode,
@@ -250,6 +284,7 @@ impl Settings {
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ContactMode>()?;
+    m.add_class::<VolumeScheme>()?;
     m.add_class::<DivergenceLimits>()?;
     m.add_class::<Settings>()?;
     Ok(())

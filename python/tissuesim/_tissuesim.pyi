@@ -73,6 +73,14 @@ class ContactMode(enum.Enum):
     SampledPoints = 1
     """The paper's mode: tool surface samples push particles out."""
 
+class VolumeScheme(enum.Enum):
+    """What one volume constraint keeps."""
+
+    Tetrahedra = 0
+    """One constraint per tetrahedron (the paper's; the default)."""
+    DualCells = 1
+    """One constraint per particle on its dual cell: does not lock as ν → 0.5."""
+
 class DivergenceLimits:
     """Bounds beyond which a step is rolled back (relative to the body's rest size, the
     diagonal of its rest bounding box; ``float('inf')`` switches a check off)."""
@@ -121,6 +129,8 @@ class Settings:
     """XPBD per-tetrahedron volume constraints. Default True."""
     volumetric_split: bool
     """With volume constraints: λ carried by them (compliance 1/λ). Default True."""
+    volume_scheme: VolumeScheme
+    """What each volume constraint keeps. Default VolumeScheme.Tetrahedra."""
     volume_compliance: float
     """Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0."""
     iterations: int
