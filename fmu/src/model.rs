@@ -125,7 +125,7 @@ crate::fmi2_variables! {
         YOUNGS_MODULUS = param("youngs_modulus", Fixed, "Pa", 5.0e3, Some(0.0), "Young's modulus E of the organ"),
         POISSON_RATIO = Variable::real("poisson_ratio", Parameter, Fixed, "", Some(0.45), Some(tissuesim::MIN_POISSON_RATIO), Some(tissuesim::MAX_POISSON_RATIO), "Poisson ratio nu of the organ, in [0, 0.499] (no auxetic tissue; the volumetric stiffness diverges at 0.5)"),
         DENSITY = param("density", Fixed, "kg/m3", 1060.0, Some(0.0), "Mass density of the organ"),
-        DAMPING = param("damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha dt) per substep"),
+        DAMPING = param("damping", Tunable, "1/s", 2.0, Some(0.0), "Mass-proportional (ambient) damping rate alpha: velocities scale by 1/(1 + alpha h) per substep of length h"),
         FRICTION_STATIC = param("friction_static", Fixed, "", 0.2, Some(0.0), "Static friction coefficient between tool and tissue"),
         FRICTION_KINETIC = param("friction_kinetic", Fixed, "", 0.1, Some(0.0), "Kinetic friction coefficient between tool and tissue (<= friction_static)"),
         TOOL_SHAPE = Variable::enumeration("tool_shape", Parameter, Fixed, &TOOL_SHAPE_TYPE, 0, "Tool shape: 0 sphere, 1 capsule, 2 cylinder, 3 box"),
