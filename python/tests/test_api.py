@@ -240,7 +240,7 @@ def test_invalid_input_raises_and_leaves_the_world_as_it_was():
         world.step()
     saved = world.save_state()
 
-    with pytest.raises(ValueError, match=r"material\.poisson_ratio must be in \[0, 0\.49\]"):
+    with pytest.raises(ValueError, match=r"material\.poisson_ratio must be in \[0, 0\.499\]"):
         world.add_body(
             ts.mesh.default_organ(),
             ts.BodyOptions(material=ts.Material(poisson_ratio=0.6)),
