@@ -63,8 +63,9 @@ fn sag_error(
     (e / n).sqrt()
 }
 
-/// A TetGen liver in mesh units, E 3000, ρ 1, g 0.981, top 10% fixed.
-fn liver_error(name: &str, nu: Real, settings: Settings, options: BodyOptions) -> Real {
+/// The data mesh `name` in mesh units, its nodes in the top 10% of its height (the fixed
+/// ones of the references) and its node ids.
+fn hanging_mesh(name: &str) -> (TetMesh, Vec<u32>, Vec<usize>) {
     let mesh = mesh::load(&common::mesh_path(&format!("{name}.node")), 1.0)
         .unwrap()
         .0;
@@ -74,6 +75,12 @@ fn liver_error(name: &str, nu: Real, settings: Settings, options: BodyOptions) -
         .filter(|&i| mesh.nodes[i as usize].y >= thr)
         .collect();
     let ids: Vec<usize> = (0..mesh.nodes.len()).collect();
+    (mesh, fixed, ids)
+}
+
+/// A TetGen liver in mesh units, E 3000, ρ 1, g 0.981, top 10% fixed.
+fn liver_error(name: &str, nu: Real, settings: Settings, options: BodyOptions) -> Real {
+    let (mesh, fixed, ids) = hanging_mesh(name);
     let material = Material {
         youngs_modulus: 3000.0,
         poisson_ratio: nu,
@@ -199,15 +206,7 @@ fn against_taylor_hood_on_meshes_from_another_mesher() {
         ),
         ("liver_gmsh", [(0.45, 0.042), (0.49, 0.180), (0.499, 0.524)]),
     ] {
-        let mesh = mesh::load(&common::mesh_path(&format!("{name}.node")), 1.0)
-            .unwrap()
-            .0;
-        let (lo, hi) = mesh.bounding_box();
-        let thr = hi.y - 0.1 * (hi.y - lo.y);
-        let fixed: Vec<u32> = (0..mesh.nodes.len() as u32)
-            .filter(|&i| mesh.nodes[i as usize].y >= thr)
-            .collect();
-        let ids: Vec<usize> = (0..mesh.nodes.len()).collect();
+        let (mesh, fixed, ids) = hanging_mesh(name);
         for (nu, measured) in cases {
             let tag = format!("nu0{}", format!("{nu}").trim_start_matches("0."));
             let (th, p1) = (

@@ -64,27 +64,31 @@ fn domains(mesh: &TetMesh, keys: fn(&[u32; 4]) -> Vec<Vec<u32>>, share: Real) ->
     let mut keys: Vec<_> = by_key.into_iter().collect();
     keys.sort();
     keys.into_iter()
-        .map(|(_, tets)| {
-            let mut nodes: Vec<u32> = tets.iter().flat_map(|&t| mesh.tets[t]).collect();
-            nodes.sort_unstable();
-            nodes.dedup();
-            let mut gradient = vec![Vec3::zeros(); nodes.len()];
-            let mut total = 0.0;
-            for &t in &tets {
-                let tet = &mesh.tets[t];
-                for (c, g) in scaled_gradients(&mesh.nodes, tet).iter().enumerate() {
-                    gradient[nodes.binary_search(&tet[c]).unwrap()] += g;
-                }
-                total += volume(&mesh.nodes, tet);
-            }
-            gradient.iter_mut().for_each(|g| *g /= total);
-            Domain {
-                nodes,
-                gradient,
-                volume: share * total,
-            }
-        })
+        .map(|(_, tets)| smoothing_domain(mesh, &tets, share))
         .collect()
+}
+
+/// The domain made of the tetrahedra `tets`, each giving `share` of its volume: the
+/// volume-weighted mean of their gradients over their nodes.
+fn smoothing_domain(mesh: &TetMesh, tets: &[usize], share: Real) -> Domain {
+    let mut nodes: Vec<u32> = tets.iter().flat_map(|&t| mesh.tets[t]).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let mut gradient = vec![Vec3::zeros(); nodes.len()];
+    let mut total = 0.0;
+    for &t in tets {
+        let tet = &mesh.tets[t];
+        for (c, g) in scaled_gradients(&mesh.nodes, tet).iter().enumerate() {
+            gradient[nodes.binary_search(&tet[c]).unwrap()] += g;
+        }
+        total += volume(&mesh.nodes, tet);
+    }
+    gradient.iter_mut().for_each(|g| *g /= total);
+    Domain {
+        nodes,
+        gradient,
+        volume: share * total,
+    }
 }
 
 fn tet_keys(t: &[u32; 4]) -> Vec<Vec<u32>> {
@@ -115,26 +119,7 @@ fn dual_cells(mesh: &TetMesh) -> Vec<Domain> {
         tet.iter().for_each(|&k| tets_of[k as usize].push(t));
     }
     (0..n)
-        .map(|i| {
-            let mut nodes: Vec<u32> = tets_of[i].iter().flat_map(|&t| mesh.tets[t]).collect();
-            nodes.sort_unstable();
-            nodes.dedup();
-            let mut gradient = vec![Vec3::zeros(); nodes.len()];
-            let mut total = 0.0;
-            for &t in &tets_of[i] {
-                let tet = &mesh.tets[t];
-                for (c, g) in scaled_gradients(&mesh.nodes, tet).iter().enumerate() {
-                    gradient[nodes.binary_search(&tet[c]).unwrap()] += g;
-                }
-                total += volume(&mesh.nodes, tet);
-            }
-            gradient.iter_mut().for_each(|g| *g /= total);
-            Domain {
-                nodes,
-                gradient,
-                volume: 0.25 * total,
-            }
-        })
+        .map(|i| smoothing_domain(mesh, &tets_of[i], 0.25))
         .collect()
 }
 
