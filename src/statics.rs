@@ -581,21 +581,22 @@ fn newton(
     };
     let mut r = residual(body, x, g);
     let mut res = l2(&r) / weight;
-    let mut k = FactorisedStiffness::new(body, Some(x))?;
+    // The preconditioner, factorised at the first iterate that needs one and again whenever
+    // the last solve needed many iterations (factorising costs ~50 tangent products).
+    let mut k: Option<FactorisedStiffness> = None;
     let mut cg_used = 0;
     for _ in 0..max_iterations {
         if res <= tolerance {
             break;
         }
         *iterations += 1;
-        // The preconditioner is refactorised at the iterate when the last solve needed many
-        // iterations (factorising costs ~50 tangent products), kept otherwise.
-        if cg_used > REFACTORISE_AFTER {
-            k = FactorisedStiffness::new(body, Some(x))?;
+        if k.is_none() || cg_used > REFACTORISE_AFTER {
+            k = Some(FactorisedStiffness::new(body, Some(x))?);
         }
+        let preconditioner = k.as_ref().expect("factorised above");
         // Inexact Newton: a loose linear solve far from the solution, tighter near it.
         let eta = res.sqrt().clamp(1e-4, 0.1);
-        let (dx, used) = newton_direction(body, x, g, &r, &k, eta, size);
+        let (dx, used) = newton_direction(body, x, g, &r, preconditioner, eta, size);
         cg_used = used;
         // Backtrack until the energy falls by a fair share of what the slope promises
         // (Armijo), or the residual falls: near the solution the energy's change drowns in
