@@ -5,7 +5,7 @@
 //! does not lock as ν → 0.5 (the average nodal pressure tetrahedron of Bonet & Burton 1998,
 //! solved as XPBD constraints).
 
-use crate::math::{Real, Vec3};
+use crate::math::{tet_volume, tet_volume_gradient, Real, Vec3};
 
 /// For every particle, the tetrahedra around it and the particles they hold (its "star"),
 /// in compressed rows, each tetrahedron corner's slot in the star, and the cell's rest volume
@@ -127,14 +127,11 @@ impl DualCells {
         for e in self.offsets[i] as usize..self.offsets[i + 1] as usize {
             let tet = tets[self.tets[e] as usize];
             let [a, b, c, d] = tet.map(|k| x[k as usize]);
-            let gb = (c - a).cross(&(d - a)) / 24.0;
-            let gc = (d - a).cross(&(b - a)) / 24.0;
-            let gd = (b - a).cross(&(c - a)) / 24.0;
-            // A quarter of the tetrahedron's volume (b − a)·((c − a) × (d − a))/6.
-            volume += (b - a).dot(&gb);
+            // A quarter of the tetrahedron: its volume and its gradient.
+            volume += 0.25 * tet_volume(&a, &b, &c, &d);
             let slots = &self.corner_slot[4 * e..4 * e + 4];
-            for (slot, g) in slots.iter().zip([-(gb + gc + gd), gb, gc, gd]) {
-                gradient[*slot as usize] += g;
+            for (slot, g) in slots.iter().zip(tet_volume_gradient(&a, &b, &c, &d)) {
+                gradient[*slot as usize] += g * 0.25;
             }
         }
         volume
@@ -161,7 +158,7 @@ mod tests {
             .iter()
             .map(|t| {
                 let [a, b, c, d] = t.map(|k| x[k as usize]);
-                crate::math::tet_volume(&a, &b, &c, &d)
+                tet_volume(&a, &b, &c, &d)
             })
             .collect();
         assert!(vols.iter().all(|v| *v > 0.0));

@@ -21,3 +21,11 @@ pub fn is_finite_vec(v: &Vec3) -> bool {
 pub fn tet_volume(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> Real {
     (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
 }
+
+/// Gradients (m²) of [`tet_volume`] with respect to the corners `a`, `b`, `c`, `d` (m).
+pub(crate) fn tet_volume_gradient(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> [Vec3; 4] {
+    let gb = (c - a).cross(&(d - a)) / 6.0;
+    let gc = (d - a).cross(&(b - a)) / 6.0;
+    let gd = (b - a).cross(&(c - a)) / 6.0;
+    [-(gb + gc + gd), gb, gc, gd]
+}

@@ -18,7 +18,7 @@
 
 use crate::body::Body;
 use crate::error::Error;
-use crate::math::{Mat3, Real, Vec3};
+use crate::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
 use crate::settings::VolumeScheme;
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
@@ -186,9 +186,9 @@ fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &
         VolumeScheme::Tetrahedra => {
             for (t, tet) in model.tets.iter().enumerate() {
                 gradient.clear();
-                gradient.extend(tet.iter().copied().zip(volume_gradient(x, tet)));
                 let [a, b, c, d] = tet.map(|k| x[k as usize]);
-                let v = crate::math::tet_volume(&a, &b, &c, &d);
+                gradient.extend(tet.iter().copied().zip(tet_volume_gradient(&a, &b, &c, &d)));
+                let v = tet_volume(&a, &b, &c, &d);
                 f(model.tet_rest_volume[t], v, &gradient);
             }
         }
@@ -223,15 +223,6 @@ fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
     } else {
         0.0
     }
-}
-
-/// Gradients (m²) of a tetrahedron's signed volume with respect to its four corners.
-fn volume_gradient(x: &[Vec3], tet: &[u32; 4]) -> [Vec3; 4] {
-    let [a, b, c, d] = tet.map(|k| x[k as usize]);
-    let gb = (c - a).cross(&(d - a)) / 6.0;
-    let gc = (d - a).cross(&(b - a)) / 6.0;
-    let gd = (b - a).cross(&(c - a)) / 6.0;
-    [-(gb + gc + gd), gb, gc, gd]
 }
 
 /// The energy (J) whose negative gradient is [`residual`]: elastic and hourglass, the volume
