@@ -5,7 +5,7 @@
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
-//!                             [--times PATH] [--dual-cells]
+//!                             [--times PATH] [--dual-cells] [--tetrahedra]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -16,7 +16,8 @@
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
 //! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
-//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron.
+//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron;
+//! `--tetrahedra` the elasticity on corotated tetrahedra (`ElasticScheme::Tetrahedra`).
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -28,8 +29,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, Material, Pose, Real, Settings, ToolOptions, ToolShape, Vec3,
-    VolumeScheme, World,
+    mesh, BodyId, BodyOptions, ElasticScheme, Material, Pose, Real, Settings, ToolOptions,
+    ToolShape, Vec3, VolumeScheme, World,
 };
 
 /// Counts live heap bytes, for memory per particle.
@@ -201,20 +202,9 @@ fn add_organs(world: &mut World, name: &str, scene: Scene) -> (Vec<BodyId>, Vec3
     (vec![a, b, c], lo, hi)
 }
 
-fn run(
-    name: &str,
-    scene: Scene,
-    probe: bool,
-    steps: usize,
-    (threads, volume_scheme): (u32, VolumeScheme),
-) -> Row {
+fn run(name: &str, scene: Scene, probe: bool, steps: usize, settings: &Settings) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
-    let settings = Settings {
-        threads,
-        volume_scheme,
-        ..Settings::default()
-    };
-    let mut world = World::new(settings).unwrap();
+    let mut world = World::new(settings.clone()).unwrap();
     let (bodies, lo, hi) = add_organs(&mut world, name, scene);
     let top = hi.y - scene.fixed_fraction * (hi.y - lo.y);
     let organ_nodes: Vec<Vec3> = world.body(bodies[0]).unwrap().rest_positions().to_vec();
@@ -308,6 +298,7 @@ fn main() {
     let mut scene_name = "haptic".to_string();
     let mut threads = 1;
     let mut volume_scheme = VolumeScheme::Tetrahedra;
+    let mut elastic_scheme = ElasticScheme::PointBased;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -325,6 +316,7 @@ fn main() {
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
             "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
+            "--tetrahedra" => elastic_scheme = ElasticScheme::Tetrahedra,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -355,7 +347,12 @@ fn main() {
                 scene(&scene_name),
                 probe,
                 steps,
-                (threads, volume_scheme),
+                &Settings {
+                    threads,
+                    volume_scheme,
+                    elastic_scheme,
+                    ..Settings::default()
+                },
             );
             let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
             let bpp = r.bytes as f64 / r.particles as f64;

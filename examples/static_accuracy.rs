@@ -4,12 +4,13 @@
 //!
 //! ```text
 //! cargo run --release --example static_accuracy -- [--neighbours K] [--hourglass C]
-//!     [--nodal-volume] [--dual-cells] [--plain-mls] [--audit] [--tet-schemes] [--nu 0.3,0.45,...] [SCENE ...]
+//!     [--nodal-volume] [--dual-cells] [--tetrahedra] [--plain-mls] [--audit] [--tet-schemes] [--nu 0.3,0.45,...] [SCENE ...]
 //! ```
 //! The reference is P2 (displacement) below ν 0.45 and Taylor–Hood (mixed P2/P1,
 //! `*_th.csv`) from 0.45 up, where displacement-only P2 locks too (validation/README.md g).
 //! `--dual-cells`: one volume constraint per particle on its dual cell instead of one per
-//! tetrahedron (`VolumeScheme::DualCells`).
+//! tetrahedron (`VolumeScheme::DualCells`). `--tetrahedra`: the elasticity on corotated
+//! linear tetrahedra instead of the particles (`ElasticScheme::Tetrahedra`).
 //! `--tet-schemes` adds columns for tetrahedral discretisations on the same nodes (assembled
 //! in `tet_schemes.rs`): linear tets (a check of the assembly against the reference's P1
 //! column), linear tets with the volumetric energy on the nodes' dual cells (the average nodal
@@ -240,6 +241,7 @@ fn main() -> Res<()> {
             "--nodal-volume" => settings.volume_constraints = false,
             "--tet-volume" => settings.volume_constraints = true,
             "--dual-cells" => settings.volume_scheme = tissuesim::VolumeScheme::DualCells,
+            "--tetrahedra" => settings.elastic_scheme = tissuesim::ElasticScheme::Tetrahedra,
             "--plain-mls" => options.consistent_gradients = false,
             "--audit" => with_audit = true,
             "--tet-schemes" => with_schemes = true,

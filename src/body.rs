@@ -13,7 +13,8 @@ use crate::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
 use crate::neighbours::{self, Neighbourhoods};
 use crate::parallel::{Pool, SharedSlice};
 use crate::particle_order::ParticleOrder;
-use crate::settings::Settings;
+use crate::settings::{ElasticScheme, Settings};
+use crate::tet_elasticity::{self, TetForceInputs};
 use std::sync::Arc;
 
 /// An isotropic linear-elastic material (SI units).
@@ -313,9 +314,20 @@ pub struct Body {
     pub(crate) volume_constraints_on: bool,
     /// What each volume constraint keeps (`Settings::volume_scheme`).
     pub(crate) volume_scheme: crate::VolumeScheme,
+    /// What carries the elasticity (`Settings::elastic_scheme`).
+    pub(crate) elastic_scheme: ElasticScheme,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
 }
+
+/// The most volumetric stiffness λ/μ (dimensionless) that corotated tetrahedra keep in their
+/// stress when the dual cells carry the volume (`ElasticScheme::Tetrahedra` with
+/// `VolumeScheme::DualCells`): 1.5, a material of ν = 0.3 (λ/μ = 2ν/(1 - 2ν)). Up to it linear
+/// tetrahedra do not lock (their static error at ν 0.3 is that of the mesh); the dual cells
+/// alone are too soft there (their nodal volumes have spurious modes the tetrahedra
+/// suppress). Above it the dual cells carry the rest, so nearly incompressible tissue does not
+/// lock. Measured on eight organ meshes against FEM references in docs/VALIDATION.md.
+pub(crate) const TETRAHEDRON_LAMBDA_OVER_MU: Real = 1.5;
 
 /// Newton iterations of the rotation extraction per particle per substep before the exact SVD
 /// fallback (warm-started, they converge in 1–3).
@@ -338,6 +350,7 @@ impl Body {
             volume_compliance: 0.0,
             volume_constraints_on: false,
             volume_scheme: crate::VolumeScheme::Tetrahedra,
+            elastic_scheme: ElasticScheme::PointBased,
             model,
         };
         body.configure(settings);
@@ -496,9 +509,28 @@ impl Body {
     }
 
     /// Elastic (and hourglass) forces (N) on every particle if the particles were at
-    /// `positions` (m) with zero velocity; an analysis helper that allocates.
+    /// `positions` (m) with zero velocity, from the elasticity of `Settings::elastic_scheme`;
+    /// an analysis helper that allocates.
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.state.x.len()];
+        if self.elastic_scheme == ElasticScheme::Tetrahedra {
+            let mut corners = vec![Vec3::zeros(); 4 * self.model.tets.len()];
+            let at_rest = vec![Vec3::zeros(); positions.len()];
+            let input = TetForceInputs {
+                elements: &self.model.tet_elements,
+                x: positions,
+                v: &at_rest,
+                fixed: &[],
+            };
+            tet_elasticity::accumulate_forces(
+                &self.elastic,
+                &input,
+                &mut corners,
+                &mut force,
+                &Pool::new(1),
+            );
+            return force;
+        }
         let mut rotation = vec![Quat::identity(); self.state.x.len()];
         // One thread keeps no pair forces.
         let (mut pair_force, mut own_force) = (Vec::new(), Vec::new());
@@ -536,9 +568,19 @@ impl Body {
         self.volume_compliance = settings.volume_compliance;
         self.volume_constraints_on = settings.volume_constraints;
         self.volume_scheme = settings.volume_scheme;
+        self.elastic_scheme = settings.elastic_scheme;
         if settings.volume_constraints && settings.volumetric_split {
-            self.volume_compliance += 1.0 / self.elastic.lambda;
-            self.elastic.lambda = 0.0;
+            // Tetrahedra under dual cells keep the volumetric stiffness they carry without
+            // locking; the dual cells take the rest (all of it for the other schemes).
+            let kept = match (settings.elastic_scheme, settings.volume_scheme) {
+                (ElasticScheme::Tetrahedra, crate::VolumeScheme::DualCells) => self
+                    .elastic
+                    .lambda
+                    .min(TETRAHEDRON_LAMBDA_OVER_MU * self.elastic.mu),
+                _ => 0.0,
+            };
+            self.volume_compliance += 1.0 / (self.elastic.lambda - kept);
+            self.elastic.lambda = kept;
         }
         self.inertial_mass.copy_from_slice(&self.model.mass);
         self.update_inverse_masses();
@@ -588,10 +630,16 @@ impl Body {
     }
 
     /// An estimate (N/m) of each particle's diagonal stiffness at rest: the elastic terms of
-    /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms.
+    /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms, or
+    /// those of the tetrahedra around it.
     pub(crate) fn diagonal_stiffness(&self) -> Vec<Real> {
         let pwave = self.elastic.p_wave_modulus();
         let mut k = vec![0.0; self.state.x.len()];
+        if self.elastic_scheme == ElasticScheme::Tetrahedra {
+            let elements = &self.model.tet_elements;
+            tet_elasticity::add_diagonal_stiffness(&self.elastic, elements, &mut k);
+            return k;
+        }
         for (i, vi) in self.model.particle_volume.iter().enumerate() {
             let mut dsum = Vec3::zeros();
             for e in self.model.nbr.range(i) {

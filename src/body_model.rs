@@ -19,6 +19,7 @@ use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
 use crate::particle_order::ParticleOrder;
+use crate::tet_elasticity::TetElements;
 use std::sync::Arc;
 
 /// The load-time data of a body (see the module documentation).
@@ -50,6 +51,8 @@ pub struct BodyModel {
     pub(crate) tet_colouring: TetColouring,
     /// The particles' dual cells, for volume constraints per particle.
     pub(crate) dual_cells: DualCells,
+    /// The tetrahedra as corotated elements (`ElasticScheme::Tetrahedra`).
+    pub(crate) tet_elements: TetElements,
     /// Which mesh node each particle is: every array above is in particle order.
     pub(crate) order: ParticleOrder,
 }
@@ -124,6 +127,7 @@ impl BodyModel {
         let (lo, hi) = mesh.bounding_box();
         let tet_colouring = TetColouring::new(&mesh.tets, &tet_rest_volume, n);
         let dual_cells = DualCells::new(&mesh.tets, &tet_rest_volume, n);
+        let tet_elements = TetElements::new(&mesh.nodes, &mesh.tets, &tet_rest_volume, n);
         Ok(Arc::new(BodyModel {
             options: options.clone(),
             rest: mesh.nodes.clone(),
@@ -141,6 +145,7 @@ impl BodyModel {
             size: (hi - lo).norm(),
             tet_colouring,
             dual_cells,
+            tet_elements,
             order,
         }))
     }
@@ -209,6 +214,7 @@ impl BodyModel {
             + size_of_val(n.sources.as_slice())
             + self.tet_colouring.heap_bytes()
             + self.dual_cells.heap_bytes()
+            + self.tet_elements.heap_bytes()
             + 2 * size_of_val(self.order.mesh_indices())
     }
 }

@@ -28,6 +28,7 @@ use crate::dual_cells::DualCells;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::Neighbourhoods;
+use crate::tet_elasticity::TetElements;
 use std::sync::Arc;
 
 /// A blade's edge at the start and at the end of its motion over one step (m, world frame).
@@ -238,6 +239,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
     model.rest_volume = model.tet_rest_volume.iter().sum();
     model.tet_colouring = TetColouring::new(&model.tets, &model.tet_rest_volume, n);
     model.dual_cells = DualCells::new(&model.tets, &model.tet_rest_volume, n);
+    model.tet_elements = TetElements::new(&model.rest, &model.tets, &model.tet_rest_volume, n);
     let mesh = TetMesh {
         nodes: model.rest.clone(),
         tets: model.tets.clone(),

@@ -80,7 +80,7 @@ pub fn deformation_gradient(nbr: &Neighbourhoods, x: &[Vec3], i: usize) -> Mat3 
 /// First Piola–Kirchhoff stress (Pa) of the corotated model for deformation gradients `f` and
 /// their rotations `r`, lane-wise (eq. 3): `2μ (F - R) + λ tr(RᵀF - I) R`.
 #[inline(always)]
-fn corotated_stress(f: &M4, r: &M4, lambda: Real, mu: Real) -> M4 {
+pub(crate) fn corotated_stress(f: &M4, r: &M4, lambda: Real, mu: Real) -> M4 {
     let tr = r.inner(f) - F4::splat(3.0);
     f.sub(r)
         .scale(F4::splat(2.0 * mu))

@@ -575,6 +575,44 @@ impl M4 {
             z: row(r2, a.z),
         }
     }
+    /// Lane-wise the matrix with columns `a`, `b`, `c`.
+    #[inline(always)]
+    pub(crate) fn from_columns(a: &V4, b: &V4, c: &V4) -> M4 {
+        M4 {
+            rows: [
+                V4 {
+                    x: a.x,
+                    y: b.x,
+                    z: c.x,
+                },
+                V4 {
+                    x: a.y,
+                    y: b.y,
+                    z: c.y,
+                },
+                V4 {
+                    x: a.z,
+                    y: b.z,
+                    z: c.z,
+                },
+            ],
+        }
+    }
+    /// Lane-wise transpose.
+    #[inline(always)]
+    pub(crate) fn transpose(&self) -> M4 {
+        M4::from_columns(&self.rows[0], &self.rows[1], &self.rows[2])
+    }
+    /// Lane-wise matrix product `self o`: row `a` is `Σ_k self_ak (row k of o)`.
+    #[inline(always)]
+    pub(crate) fn mul_mat(&self, o: &M4) -> M4 {
+        let [o0, o1, o2] = &o.rows;
+        M4 {
+            rows: self
+                .rows
+                .map(|r| o2.scale_add(r.z, &o1.scale_add(r.y, &o0.scale(r.x)))),
+        }
+    }
     /// The sum of the four matrices.
     #[inline(always)]
     pub(crate) fn sum(&self) -> Mat3 {

@@ -21,6 +21,19 @@ pub enum ContactMode {
     SampledPoints,
 }
 
+/// What carries the elasticity (with the volume constraints on and split, its shear part).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ElasticScheme {
+    /// The paper's point-based elasticity: a moving-least-squares deformation gradient per
+    /// particle, nodal integration with hourglass control (`crate::elastic`). The default.
+    PointBased,
+    /// Corotated linear tetrahedra: one deformation gradient and rotation per tetrahedron of
+    /// the mesh, the same corotated stress (`crate::tet_elasticity`); no zero-energy modes, so
+    /// no hourglass control. The particles stay the unknowns; contact, volume constraints and
+    /// everything else are unchanged.
+    Tetrahedra,
+}
+
 /// What one volume constraint keeps (with [`Settings::volume_constraints`] on).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VolumeScheme {
@@ -95,6 +108,9 @@ pub struct Settings {
     /// What each volume constraint keeps: a tetrahedron's volume (the paper's, the default) or
     /// a particle's dual cell.
     pub volume_scheme: VolumeScheme,
+    /// What carries the elasticity: the paper's point-based particles (the default) or
+    /// corotated linear tetrahedra.
+    pub elastic_scheme: ElasticScheme,
     /// Compliance (1/Pa, per unit volume) the volume constraints get in addition to `1/λ`
     /// under the split, or in total without it (0 = hard constraints).
     pub volume_compliance: Real,
@@ -171,6 +187,7 @@ impl Default for Settings {
             volume_constraints: true,
             volumetric_split: true,
             volume_scheme: VolumeScheme::Tetrahedra,
+            elastic_scheme: ElasticScheme::PointBased,
             volume_compliance: 0.0,
             iterations: 1,
             contact_mode: ContactMode::ExactShape,

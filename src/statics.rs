@@ -19,7 +19,7 @@
 use crate::body::Body;
 use crate::error::Error;
 use crate::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
-use crate::settings::VolumeScheme;
+use crate::settings::{ElasticScheme, VolumeScheme};
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
@@ -85,14 +85,19 @@ impl BlockMatrix {
 pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     let nbr = &body.model.nbr;
     let n = body.particle_count();
-    // Stencil of particle i: itself, then its neighbours.
-    let stencils: Vec<Vec<u32>> = (0..n)
-        .map(|i| {
-            let mut s = vec![i as u32];
-            s.extend_from_slice(&nbr.index[nbr.range(i)]);
-            s
-        })
-        .collect();
+    let tetrahedra = body.elastic_scheme == ElasticScheme::Tetrahedra;
+    // Stencil of particle i: itself, then its neighbours; or of a tetrahedron, its corners.
+    let stencils: Vec<Vec<u32>> = if tetrahedra {
+        body.model.tets.iter().map(|t| t.to_vec()).collect()
+    } else {
+        (0..n)
+            .map(|i| {
+                let mut s = vec![i as u32];
+                s.extend_from_slice(&nbr.index[nbr.range(i)]);
+                s
+            })
+            .collect()
+    };
     let volume_stiffness = volume_stiffness_per_unit_volume(body);
     // Each volume term's particles, and the term's gradients at `at` (Gauss–Newton).
     let mut volume_terms: Vec<(Real, Vec<(u32, Vec3)>)> = Vec::new();
@@ -113,36 +118,50 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
             .chain(volume_stencils.iter().map(Vec::as_slice)),
     );
     let (lambda, mu, hourglass) = (body.elastic.lambda, body.elastic.mu, body.elastic.hourglass);
-    let mut c = Vec::new();
-    let mut a = Vec::new();
-    let rotations: Vec<Mat3> = match at {
-        Some(x) => (0..n)
-            .map(|i| {
-                let f = crate::elastic::deformation_gradient(nbr, x, i);
-                crate::rotation::rotation_from_svd(&f)
-                    .to_rotation_matrix()
-                    .into_inner()
-            })
-            .collect(),
-        None => vec![Mat3::identity(); n],
+    // The rotation of an element (a particle or a tetrahedron) at `at`, from its deformation
+    // gradient there.
+    let polar = |f: Mat3| {
+        crate::rotation::rotation_from_svd(&f)
+            .to_rotation_matrix()
+            .into_inner()
     };
-    for (i, stencil) in stencils.iter().enumerate() {
-        let vi = body.model.particle_volume[i];
-        let (r, rt) = (rotations[i], rotations[i].transpose());
-        let range = nbr.range(i);
-        // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
-        c.clear();
-        c.push(-nbr.gradient.iter_range(range.clone()).sum::<Vec3>());
-        c.extend(nbr.gradient.iter_range(range.clone()));
-        // Linear elasticity: K_kl = v_i [μ (c_k·c_l) I + μ c_l c_kᵀ + λ c_k c_lᵀ].
+    // Linear elasticity of an element of volume `v` whose displacement gradient is
+    // `Σ_k u_k c_kᵀ` over its stencil, warped by its rotation `r`:
+    // K_kl = v r [μ (c_k·c_l) I + μ c_l c_kᵀ + λ c_k c_lᵀ] rᵀ.
+    let add_element = |k: &mut BlockMatrix, stencil: &[u32], c: &[Vec3], r: Mat3, v: Real| {
+        let rt = r.transpose();
         for (p, ck) in c.iter().enumerate() {
             for (q, cl) in c.iter().enumerate() {
                 let block = Mat3::identity() * (mu * ck.dot(cl))
                     + cl * ck.transpose() * mu
                     + ck * cl.transpose() * lambda;
-                k.add(stencil[p], stencil[q], &(r * block * rt * vi));
+                k.add(stencil[p], stencil[q], &(r * block * rt * v));
             }
         }
+    };
+    if tetrahedra {
+        let elements = &body.model.tet_elements;
+        for (t, tet) in body.model.tets.iter().enumerate() {
+            let r = at.map_or(Mat3::identity(), |x| {
+                polar(elements.deformation_gradient(t, x))
+            });
+            let v = body.model.tet_rest_volume[t];
+            add_element(&mut k, tet, &elements.gradients(t), r, v);
+        }
+    }
+    let (mut c, mut a) = (Vec::new(), Vec::new());
+    let particles = if tetrahedra { &[][..] } else { &stencils[..] };
+    for (i, stencil) in particles.iter().enumerate() {
+        let vi = body.model.particle_volume[i];
+        let r = at.map_or(Mat3::identity(), |x| {
+            polar(crate::elastic::deformation_gradient(nbr, x, i))
+        });
+        let range = nbr.range(i);
+        // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
+        c.clear();
+        c.push(-nbr.gradient.iter_range(range.clone()).sum::<Vec3>());
+        c.extend(nbr.gradient.iter_range(range.clone()));
+        add_element(&mut k, stencil, &c, r, vi);
         // Hourglass: ½ c_ij |ε_ij|², ε_ij = Σ_k a_k x_k with a_k = c_k·u_ij − δ_kj + δ_ki.
         if hourglass != 0.0 {
             for (slot, e) in range.enumerate() {
@@ -229,7 +248,14 @@ fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
 /// terms, and the weight's potential `−Σ m g·x`, at positions `x` (m).
 fn energy(body: &Body, x: &[Vec3], g: Vec3) -> Real {
     let model = &body.model;
-    let mut e = crate::elastic::energy(&body.elastic, &model.nbr, &model.particle_volume, x);
+    let mut e = match body.elastic_scheme {
+        ElasticScheme::PointBased => {
+            crate::elastic::energy(&body.elastic, &model.nbr, &model.particle_volume, x)
+        }
+        ElasticScheme::Tetrahedra => {
+            crate::tet_elasticity::energy(&body.elastic, &model.tet_elements, x)
+        }
+    };
     let stiffness = volume_stiffness_per_unit_volume(body);
     if stiffness > 0.0 {
         for_each_volume_term(body, x, |v0, v, _| {

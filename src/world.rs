@@ -126,6 +126,7 @@ impl World {
             || settings.volume_constraints != s.volume_constraints
             || settings.volumetric_split != s.volumetric_split
             || settings.volume_scheme != s.volume_scheme
+            || settings.elastic_scheme != s.elastic_scheme
             || settings.volume_compliance != s.volume_compliance
             || settings.damping_stiffness != s.damping_stiffness
             || settings.mass_scaling != s.mass_scaling

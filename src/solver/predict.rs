@@ -4,7 +4,9 @@ use crate::body::{Body, ROTATION_ITERATIONS};
 use crate::elastic::{accumulate_forces, ForceInputs};
 use crate::math::{Real, Vec3};
 use crate::parallel::{Pool, SharedSlice};
+use crate::settings::ElasticScheme;
 use crate::solver::StepScratch;
+use crate::tet_elasticity::{self, TetForceInputs};
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s): velocities into
 /// the body's state, forces and predicted positions into its `scratch`.
@@ -37,23 +39,39 @@ pub(crate) fn predict(
         }
         lambda.fill(0.0);
     });
-    let input = ForceInputs {
-        nbr: &body.model.nbr,
-        volume: &body.model.particle_volume,
-        x: &body.state.x,
-        v: &body.state.v,
-        active_before: &body.active_before,
-    };
-    accumulate_forces(
-        &body.elastic,
-        &input,
-        &mut body.state.rotation,
-        ROTATION_ITERATIONS,
-        &mut scratch.pair_force,
-        &mut scratch.own_force,
-        &mut scratch.force,
-        pool,
-    );
+    match body.elastic_scheme {
+        ElasticScheme::PointBased => {
+            let input = ForceInputs {
+                nbr: &body.model.nbr,
+                volume: &body.model.particle_volume,
+                x: &body.state.x,
+                v: &body.state.v,
+                active_before: &body.active_before,
+            };
+            accumulate_forces(
+                &body.elastic,
+                &input,
+                &mut body.state.rotation,
+                ROTATION_ITERATIONS,
+                &mut scratch.pair_force,
+                &mut scratch.own_force,
+                &mut scratch.force,
+                pool,
+            );
+        }
+        ElasticScheme::Tetrahedra => tet_elasticity::accumulate_forces(
+            &body.elastic,
+            &TetForceInputs {
+                elements: &body.model.tet_elements,
+                x: &body.state.x,
+                v: &body.state.v,
+                fixed: &body.fixed,
+            },
+            &mut scratch.corner_force,
+            &mut scratch.force,
+            pool,
+        ),
+    }
     let n = body.state.x.len();
     let state = &mut body.state;
     let (x, force, inv_mass, fixed) = (&state.x, &scratch.force, &body.inv_mass, &body.fixed);

@@ -29,6 +29,10 @@ pub(crate) struct StepScratch {
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones), or
     /// one per particle for dual cells (the array holds the larger count).
     pub(crate) tet_lambda: Vec<Real>,
+    /// The corner forces of the tetrahedron force pass (N) kept for the sums after its
+    /// barrier, four per load-time tetrahedron (`ElasticScheme::Tetrahedra`; a cut body uses
+    /// the first ones); empty on one thread, where they go straight to the particles.
+    pub(crate) corner_force: Vec<Vec3>,
     /// A dual cell's volume gradient with respect to each particle of its star (m²), for the
     /// projection of one cell; capacity the model's largest star, so it never grows in a step.
     pub(crate) cell_gradient: Vec<Vec3>,
@@ -46,6 +50,7 @@ impl StepScratch {
             pair_force: Vec::new(),
             own_force: Vec::new(),
             tet_lambda: vec![0.0; model.tets.len().max(n)],
+            corner_force: Vec::new(),
             cell_gradient: Vec::with_capacity(model.dual_cells.max_star()),
             scan: ParticleScan::EMPTY,
         };
@@ -69,13 +74,18 @@ impl StepScratch {
     /// Size the force pass's kept forces for `threads` threads: a body's worth on several,
     /// none on one (the memory is freed).
     fn size_kept(&mut self, model: &BodyModel, threads: usize) {
-        let (slots, particles) = match threads {
-            1 => (0, 0),
-            _ => (model.nbr.slot_count(), model.particle_count()),
+        let (slots, particles, corners) = match threads {
+            1 => (0, 0, 0),
+            _ => (
+                model.nbr.slot_count(),
+                model.particle_count(),
+                4 * model.tets.len(),
+            ),
         };
         for (kept, len) in [
             (&mut self.pair_force, slots),
             (&mut self.own_force, particles),
+            (&mut self.corner_force, corners),
         ] {
             kept.resize(len, Vec3::zeros());
             kept.shrink_to_fit();
