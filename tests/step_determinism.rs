@@ -4,17 +4,20 @@
 mod common;
 
 use common::{fix_top, two_bodies_stacked};
-use tissuesim::{Pose, Settings, ToolOptions, ToolShape, Vec3, World};
+use tissuesim::{Pose, Settings, ToolOptions, ToolShape, Vec3, VolumeScheme, World};
 
 fn scene() -> World {
     scene_with_threads(1)
 }
 
 fn scene_with_threads(threads: u32) -> World {
-    let settings = Settings {
+    scene_with(Settings {
         threads,
         ..Settings::default()
-    };
+    })
+}
+
+fn scene_with(settings: Settings) -> World {
     let (mut world, a, b) = two_bodies_stacked(settings);
     fix_top(&mut world, b, 0.05);
     world.set_body_pair_friction(a, b, 0.4, 0.3).unwrap();
@@ -90,6 +93,30 @@ fn thread_count_does_not_change_a_bit() {
     assert_eq!(
         one.tool(tool).unwrap().wrench(),
         three.tool(tool).unwrap().wrench()
+    );
+}
+
+/// The dual cells' pass runs colour by colour on the pool (both bodies have enough cells to
+/// be split over the threads): the same bits on one thread and on two.
+#[test]
+fn thread_count_does_not_change_a_bit_with_dual_cells() {
+    let dual_cells = |threads| {
+        scene_with(Settings {
+            threads,
+            volume_scheme: VolumeScheme::DualCells,
+            ..Settings::default()
+        })
+    };
+    let (mut one, mut two) = (dual_cells(1), dual_cells(2));
+    for w in [&mut one, &mut two] {
+        drive(w, 0, 300);
+    }
+    assert_eq!(positions(&one), positions(&two));
+    let tool = tissuesim::ToolId(0);
+    assert!(one.tool(tool).unwrap().wrench().contact_count > 0);
+    assert_eq!(
+        one.tool(tool).unwrap().wrench(),
+        two.tool(tool).unwrap().wrench()
     );
 }
 
