@@ -213,11 +213,13 @@ fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &
         }
         VolumeScheme::DualCells => {
             let cells = &model.dual_cells;
-            let mut cell_gradient = Vec::new();
+            let mut relative = vec![Vec3::zeros(); cells.max_star()];
+            let mut cell_gradient = vec![Vec3::zeros(); cells.max_star()];
             for i in 0..cells.len() {
                 let v0 = cells.rest_volume(i);
                 if v0 > 0.0 {
-                    let v = cells.volume_and_gradient(i, &model.tets, x, &mut cell_gradient);
+                    let v =
+                        cells.volume_and_gradient(i, |k| x[k], &mut relative, &mut cell_gradient);
                     gradient.clear();
                     gradient.extend(
                         cells

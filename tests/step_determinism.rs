@@ -106,6 +106,30 @@ fn thread_count_does_not_change_a_bit() {
     );
 }
 
+/// The dual cells' pass runs colour by colour on the pool (both bodies have enough cells to
+/// be split over the threads): the same bits on one thread and on two.
+#[test]
+fn thread_count_does_not_change_a_bit_with_dual_cells() {
+    let dual_cells = |threads| {
+        scene_with(Settings {
+            threads,
+            volume_scheme: VolumeScheme::DualCells,
+            ..Settings::default()
+        })
+    };
+    let (mut one, mut two) = (dual_cells(1), dual_cells(2));
+    for w in [&mut one, &mut two] {
+        drive(w, 0, 300);
+    }
+    assert_eq!(positions(&one), positions(&two));
+    let tool = tissuesim::ToolId(0);
+    assert!(one.tool(tool).unwrap().wrench().contact_count > 0);
+    assert_eq!(
+        one.tool(tool).unwrap().wrench(),
+        two.tool(tool).unwrap().wrench()
+    );
+}
+
 /// The tetrahedron force pass (corner slots and a gather on several threads, straight to the
 /// particles on one) and the dual cells give the same bits on any thread count, and a restored
 /// state reproduces the run (the tetrahedra's rotations carry no state).

@@ -50,6 +50,7 @@ fn steps_after_the_first_do_not_allocate() {
         (ContactMode::SampledPoints, 1, VolumeScheme::Tetrahedra),
         (ContactMode::ExactShape, 2, VolumeScheme::Tetrahedra),
         (ContactMode::ExactShape, 1, VolumeScheme::DualCells),
+        (ContactMode::ExactShape, 2, VolumeScheme::DualCells),
     ] {
         let settings = Settings {
             contact_mode: mode,

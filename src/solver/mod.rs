@@ -222,7 +222,9 @@ impl World {
                         VolumeScheme::Tetrahedra => {
                             volume::project_volumes(body, scratch, h, &self.pool)
                         }
-                        VolumeScheme::DualCells => volume::project_dual_cells(body, scratch, h),
+                        VolumeScheme::DualCells => {
+                            volume::project_dual_cells(body, scratch, h, &self.pool)
+                        }
                     }
                 }
             }

@@ -3,7 +3,8 @@
 //! particle) split over the thread pool, each block's tetrahedra in their order, four blocks
 //! in lock-step, one a lane (`volume_tet_corrections4`). The blocks share no particle, so the
 //! result is that of projecting them one after the other, and it does not depend on the
-//! thread count.
+//! thread count. The dual-cell constraints (one per particle) run the same way, colour by
+//! colour, their cells in place of the blocks.
 
 use crate::body::Body;
 use crate::constraints::volume::{volume_tet_correction, volume_tet_corrections4};
@@ -11,6 +12,7 @@ use crate::lanes::{F4, LANES, V4};
 use crate::math::Real;
 use crate::parallel::{Barrier, Pool, SharedSlice};
 use crate::solver::StepScratch;
+use std::ops::Range;
 
 /// Below this many tetrahedra a body's pass stays on one thread: the synchronisation (one
 /// barrier per colour) costs about as much as projecting a few hundred tetrahedra per colour.
@@ -134,48 +136,72 @@ pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, p
     });
 }
 
+/// Below this many dual cells a body's pass stays on one thread: a colour is a barrier, and
+/// the cells need a few tens of colours.
+const MIN_PARALLEL_CELLS: usize = 1024;
+
 /// One Gauss–Seidel pass over a body's dual-cell volume constraints for a substep `h` (s), on
-/// its predicted positions in `scratch`, particle by particle in order on the calling thread
-/// (the same bits for any thread count). Particle `i`'s constraint `C_i = V_i(x) − V_i⁰` (its
-/// cell's volume against its rest volume, m³) has the XPBD compliance of the body's compliance
-/// per unit volume (1/Pa) times `V_i⁰`, divided by h²; its correction moves every particle of
-/// the cell's tetrahedra.
-pub(crate) fn project_dual_cells(body: &Body, scratch: &mut StepScratch, h: Real) {
+/// its predicted positions in `scratch`, in the cells' colour order (`DualCells::colours`):
+/// the colours in sequence, the cells of a colour (whose stars share no particle) split over
+/// the thread pool, with a barrier between colours; the same bits for any thread count.
+/// Particle `i`'s constraint `C_i = V_i(x) − V_i⁰` (its cell's volume against its rest volume,
+/// m³) has the XPBD compliance of the body's compliance per unit volume (1/Pa) times `V_i⁰`,
+/// divided by h²; its correction moves every particle of the cell's tetrahedra.
+pub(crate) fn project_dual_cells(body: &Body, scratch: &mut StepScratch, h: Real, pool: &Pool) {
     if !body.volume_compliance.is_finite() {
         return;
     }
     let compliance_per_h2 = body.volume_compliance / (h * h);
-    let model = &body.model;
-    let cells = &model.dual_cells;
-    let StepScratch {
-        p,
-        tet_lambda,
-        cell_gradient,
-        ..
-    } = scratch;
-    for (i, lambda) in tet_lambda[..cells.len()].iter_mut().enumerate() {
-        let v0 = cells.rest_volume(i);
-        if v0 <= 0.0 {
-            continue;
+    let cells = &body.model.dual_cells;
+    let order = cells.projection_order();
+    let star = cells.max_star();
+    let p = SharedSlice::new(&mut scratch.p);
+    let lambda = SharedSlice::new(&mut scratch.tet_lambda[..order.len()]);
+    let cell_scratch = SharedSlice::new(&mut scratch.cell_scratch);
+    // The cells at `positions` of the projection order, with share `share`'s scratch.
+    // SAFETY (the closure's accesses): within a colour no two cells' stars share a particle,
+    // a cell's multiplier is its own (by its position), and each share has its own scratch;
+    // a share projects only its cells of the colour, and the shares meet at the barrier before
+    // the next colour.
+    let project = |share: usize, positions: Range<usize>| {
+        let mine = unsafe { cell_scratch.range(2 * share * star..2 * (share + 1) * star) };
+        let (relative, gradient) = mine.split_at_mut(star);
+        let lambda = unsafe { lambda.range(positions.clone()) };
+        for (&i, lambda) in order[positions].iter().zip(lambda) {
+            let i = i as usize;
+            let v0 = cells.rest_volume(i);
+            let v = cells.volume_and_gradient(i, |k| *unsafe { p.element(k) }, relative, gradient);
+            let star = cells.star(i);
+            let alpha = compliance_per_h2 * v0;
+            let weight: Real = star
+                .iter()
+                .zip(gradient.iter())
+                .map(|(k, g)| body.inv_mass[*k as usize] * g.norm_squared())
+                .sum();
+            let denominator = weight + alpha;
+            if denominator <= 0.0 {
+                continue;
+            }
+            let dl = (-(v - v0) - alpha * *lambda) / denominator;
+            *lambda += dl;
+            for (k, g) in star.iter().zip(gradient.iter()) {
+                *unsafe { p.element(*k as usize) } += g * (body.inv_mass[*k as usize] * dl);
+            }
         }
-        let v = cells.volume_and_gradient(i, &model.tets, p, cell_gradient);
-        let star = cells.star(i);
-        let alpha = compliance_per_h2 * v0;
-        let weight: Real = star
-            .iter()
-            .zip(cell_gradient.iter())
-            .map(|(k, g)| body.inv_mass[*k as usize] * g.norm_squared())
-            .sum();
-        let denominator = weight + alpha;
-        if denominator <= 0.0 {
-            continue;
-        }
-        let dl = (-(v - v0) - alpha * *lambda) / denominator;
-        *lambda += dl;
-        for (k, g) in star.iter().zip(cell_gradient.iter()) {
-            p[*k as usize] += g * (body.inv_mass[*k as usize] * dl);
-        }
+    };
+    if pool.threads() == 1 || order.len() < MIN_PARALLEL_CELLS {
+        cells.colours().for_each(|colour| project(0, colour));
+        return;
     }
+    let barrier = Barrier::new(pool.threads());
+    pool.run(&|share| {
+        let _guard = barrier.guard();
+        for colour in cells.colours() {
+            let mine = pool.share(share, colour.len());
+            project(share, colour.start + mine.start..colour.start + mine.end);
+            barrier.wait();
+        }
+    });
 }
 
 /// `[f(0), f(1), f(2), f(3)]`, always inlined (`array::map` and `from_fn` are not always, in a

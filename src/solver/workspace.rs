@@ -27,15 +27,17 @@ pub(crate) struct StepScratch {
     pub(crate) own_force: Vec<Vec3>,
     /// XPBD multipliers of the volume constraints within a substep: one per load-time
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones), or
-    /// one per particle for dual cells (the array holds the larger count).
+    /// one per dual cell, in the cells' projection order (`DualCells::projection_order`; the
+    /// array holds the larger count).
     pub(crate) tet_lambda: Vec<Real>,
     /// The corner forces of the tetrahedron force pass (N) kept for the sums after its
     /// barrier, four per load-time tetrahedron (`ElasticScheme::Tetrahedra`; a cut body uses
     /// the first ones); empty on one thread, where they go straight to the particles.
     pub(crate) corner_force: Vec<Vec3>,
-    /// A dual cell's volume gradient with respect to each particle of its star (m²), for the
-    /// projection of one cell; capacity the model's largest star, so it never grows in a step.
-    pub(crate) cell_gradient: Vec<Vec3>,
+    /// The dual-cell projection's scratch, per thread two runs of the model's largest star:
+    /// the star's positions relative to the cell's particle (m), then the cell volume's
+    /// gradient with respect to each of them (m²).
+    pub(crate) cell_scratch: Vec<Vec3>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
 }
@@ -51,7 +53,7 @@ impl StepScratch {
             own_force: Vec::new(),
             tet_lambda: vec![0.0; model.tets.len().max(n)],
             corner_force: Vec::new(),
-            cell_gradient: Vec::with_capacity(model.dual_cells.max_star()),
+            cell_scratch: Vec::new(),
             scan: ParticleScan::EMPTY,
         };
         scratch.size_kept(model, threads);
@@ -71,8 +73,9 @@ impl StepScratch {
         }
     }
 
-    /// Size the force pass's kept forces for `threads` threads: a body's worth on several,
-    /// none on one (the memory is freed).
+    /// Size the force pass's kept forces for `threads` threads (a body's worth on several,
+    /// none on one: the memory is freed) and the dual-cell scratch (a run per thread; a cut
+    /// only removes tetrahedra, so no star outgrows it).
     fn size_kept(&mut self, model: &BodyModel, threads: usize) {
         let (slots, particles, corners) = match threads {
             1 => (0, 0, 0),
@@ -82,10 +85,12 @@ impl StepScratch {
                 4 * model.tets.len(),
             ),
         };
+        let cell_scratch = 2 * threads * model.dual_cells.max_star();
         for (kept, len) in [
             (&mut self.pair_force, slots),
             (&mut self.own_force, particles),
             (&mut self.corner_force, corners),
+            (&mut self.cell_scratch, cell_scratch),
         ] {
             kept.resize(len, Vec3::zeros());
             kept.shrink_to_fit();
