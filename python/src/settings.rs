@@ -1,4 +1,4 @@
-//! `Settings`, `DivergenceLimits`, `ContactMode` and `VolumeScheme`: the world's parameters, every field as in
+//! `Settings`, `DivergenceLimits`, `ContactMode`, `VolumeScheme` and `ElasticScheme`: the world's parameters, every field as in
 //! the Rust `tissuesim::Settings` (SI units; see the `.pyi` stub for each field's unit).
 
 use pyo3::prelude::*;
@@ -57,6 +57,34 @@ impl From<tissuesim::VolumeScheme> for VolumeScheme {
         match m {
             tissuesim::VolumeScheme::Tetrahedra => VolumeScheme::Tetrahedra,
             tissuesim::VolumeScheme::DualCells => VolumeScheme::DualCells,
+        }
+    }
+}
+
+/// What carries the elasticity.
+#[pyclass(module = "tissuesim", eq, eq_int, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum ElasticScheme {
+    /// The paper's point-based particles (MLS deformation gradient; the default).
+    PointBased,
+    /// Corotated linear tetrahedra of the mesh.
+    Tetrahedra,
+}
+
+impl From<ElasticScheme> for tissuesim::ElasticScheme {
+    fn from(m: ElasticScheme) -> Self {
+        match m {
+            ElasticScheme::PointBased => tissuesim::ElasticScheme::PointBased,
+            ElasticScheme::Tetrahedra => tissuesim::ElasticScheme::Tetrahedra,
+        }
+    }
+}
+
+impl From<tissuesim::ElasticScheme> for ElasticScheme {
+    fn from(m: tissuesim::ElasticScheme) -> Self {
+        match m {
+            tissuesim::ElasticScheme::PointBased => ElasticScheme::PointBased,
+            tissuesim::ElasticScheme::Tetrahedra => ElasticScheme::Tetrahedra,
         }
     }
 }
@@ -144,6 +172,8 @@ pub struct Settings {
     pub volumetric_split: bool,
     /// What each volume constraint keeps. Default VolumeScheme.Tetrahedra.
     pub volume_scheme: VolumeScheme,
+    /// What carries the elasticity. Default ElasticScheme.PointBased.
+    pub elastic_scheme: ElasticScheme,
     /// Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0.
     pub volume_compliance: Real,
     /// Gauss-Seidel iterations over all constraints per substep. Default 1.
@@ -177,6 +207,7 @@ impl Settings {
             volume_constraints: self.volume_constraints,
             volumetric_split: self.volumetric_split,
             volume_scheme: self.volume_scheme.into(),
+            elastic_scheme: self.elastic_scheme.into(),
             volume_compliance: self.volume_compliance,
             iterations: self.iterations,
             contact_mode: self.contact_mode.into(),
@@ -201,6 +232,7 @@ impl Settings {
             volume_constraints: s.volume_constraints,
             volumetric_split: s.volumetric_split,
             volume_scheme: s.volume_scheme.into(),
+            elastic_scheme: s.elastic_scheme.into(),
             volume_compliance: s.volume_compliance,
             iterations: s.iterations,
             contact_mode: s.contact_mode.into(),
@@ -236,6 +268,7 @@ impl Settings {
                 volume_constraints,
                 volumetric_split,
                 volume_scheme,
+                elastic_scheme,
                 volume_compliance,
                 iterations,
                 contact_mode,
@@ -270,6 +303,7 @@ impl Settings {
                 volume_constraints,
                 volumetric_split,
                 volume_scheme,
+                elastic_scheme,
                 volume_compliance,
                 iterations,
                 contact_mode,
@@ -285,6 +319,7 @@ impl Settings {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ContactMode>()?;
     m.add_class::<VolumeScheme>()?;
+    m.add_class::<ElasticScheme>()?;
     m.add_class::<DivergenceLimits>()?;
     m.add_class::<Settings>()?;
     Ok(())

@@ -142,7 +142,8 @@ def test_settings_mirror_every_rust_field():
     fields = [
         "dt", "gravity", "min_substeps", "max_substeps", "stability_margin", "mass_scaling",
         "damping_mass", "damping_stiffness", "hourglass_stiffness", "volume_constraints",
-        "volumetric_split", "volume_scheme", "volume_compliance", "iterations", "contact_mode",
+        "volumetric_split", "volume_scheme", "elastic_scheme", "volume_compliance", "iterations",
+        "contact_mode",
         "max_depenetration_speed", "self_contact", "threads", "divergence",
     ]  # fmt: skip
     s = ts.Settings()
@@ -151,11 +152,13 @@ def test_settings_mirror_every_rust_field():
     assert s.dt == 1e-3 and s.gravity == [0.0, -9.81, 0.0]
     assert s.contact_mode == ts.ContactMode.ExactShape
     assert s.volume_scheme == ts.VolumeScheme.Tetrahedra
+    assert s.elastic_scheme == ts.ElasticScheme.PointBased
     custom = ts.Settings(
         dt=5e-4,
         threads=2,
         contact_mode=ts.ContactMode.SampledPoints,
         volume_scheme=ts.VolumeScheme.DualCells,
+        elastic_scheme=ts.ElasticScheme.Tetrahedra,
         divergence=ts.DivergenceLimits(max_speed=100.0),
     )
     world = ts.World(custom)

@@ -81,6 +81,14 @@ class VolumeScheme(enum.Enum):
     DualCells = 1
     """One constraint per particle on its dual cell: does not lock as ν → 0.5."""
 
+class ElasticScheme(enum.Enum):
+    """What carries the elasticity."""
+
+    PointBased = 0
+    """The paper's point-based particles (MLS deformation gradient; the default)."""
+    Tetrahedra = 1
+    """Corotated linear tetrahedra of the mesh; with DualCells they do not lock as ν → 0.5."""
+
 class DivergenceLimits:
     """Bounds beyond which a step is rolled back (relative to the body's rest size, the
     diagonal of its rest bounding box; ``float('inf')`` switches a check off)."""
@@ -131,6 +139,8 @@ class Settings:
     """With volume constraints: λ carried by them (compliance 1/λ). Default True."""
     volume_scheme: VolumeScheme
     """What each volume constraint keeps. Default VolumeScheme.Tetrahedra."""
+    elastic_scheme: ElasticScheme
+    """What carries the elasticity. Default ElasticScheme.PointBased."""
     volume_compliance: float
     """Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0."""
     iterations: int
