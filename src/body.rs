@@ -318,6 +318,10 @@ pub struct Body {
     pub(crate) elastic_scheme: ElasticScheme,
     /// Largest angular frequency of the linearised elastic system at rest (rad/s).
     pub(crate) omega_max: Real,
+    /// The same with the physical masses, once estimated: it depends on the model and the
+    /// elastic model alone, so a change of the time step (an FMU master varying its step)
+    /// does not estimate it again. A cut forgets it.
+    pub(crate) omega_physical: Option<Real>,
 }
 
 /// The most volumetric stiffness λ/μ (dimensionless) that corotated tetrahedra keep in their
@@ -347,6 +351,7 @@ impl Body {
             active_before: (0..=n as u32).collect(),
             cuts: None,
             omega_max: 0.0,
+            omega_physical: None,
             volume_compliance: 0.0,
             volume_constraints_on: false,
             volume_scheme: crate::VolumeScheme::Tetrahedra,
@@ -556,8 +561,11 @@ impl Body {
     }
 
     /// Apply the world's settings: the elastic model's hourglass and damping terms, the mass
-    /// scaling for substeps of `dt / min_substeps`, and the stability estimate.
+    /// scaling for substeps of `dt / min_substeps`, and the stability estimate. The estimate
+    /// with the physical masses is kept while the elastic model and the scheme stay the same:
+    /// a new time step costs nothing unless it needs mass scaling.
     pub(crate) fn configure(&mut self, settings: &Settings) {
+        let before = (self.elastic, self.elastic_scheme);
         let m = self.model.options.material;
         self.elastic = ElasticModel::new(
             m.youngs_modulus,
@@ -582,13 +590,20 @@ impl Body {
             self.volume_compliance += 1.0 / (self.elastic.lambda - kept);
             self.elastic.lambda = kept;
         }
+        if (self.elastic, self.elastic_scheme) != before {
+            self.omega_physical = None;
+        }
         self.inertial_mass.copy_from_slice(&self.model.mass);
         self.update_inverse_masses();
-        self.omega_max = crate::stability::max_angular_frequency(
-            self.rest_positions(),
-            self.inertial_masses(),
-            |x| self.elastic_forces_at(x),
-        );
+        self.omega_max = match self.omega_physical {
+            Some(omega) => omega,
+            None => crate::stability::max_angular_frequency(
+                self.rest_positions(),
+                self.inertial_masses(),
+                |x| self.elastic_forces_at(x),
+            ),
+        };
+        self.omega_physical = Some(self.omega_max);
         if settings.mass_scaling {
             let h = settings.dt / settings.min_substeps as Real;
             let omega_target = 2.0 * settings.stability_margin / h;

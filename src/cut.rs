@@ -254,8 +254,10 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
 /// masses above the physical ones), a particle whose diagonal stiffness rose above its load-time
 /// value gets its load-time inertial mass scaled by the same factor, so its local frequency
 /// stays where mass scaling put it; a function of the current topology only, so restoring a
-/// state reproduces it. Without mass scaling, the stability limit is estimated anew.
+/// state reproduces it. Without mass scaling, the stability limit is estimated anew. Either
+/// way the estimate with the physical masses, which the new topology changes, is forgotten.
 fn restabilise(body: &mut Body, state: &CutState) {
+    body.omega_physical = None;
     let scaled = state
         .inertial_mass
         .iter()
