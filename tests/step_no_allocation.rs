@@ -1,5 +1,6 @@
 //! No heap allocation inside a step after the first: two bodies in organ–organ contact, a probe
-//! with friction pressing one of them, in both contact modes, on one and on two threads. Every
+//! with friction pressing one of them, in both contact modes, on one and on two threads, and
+//! with surface self-contact. Every
 //! thread's allocations are counted (this file holds a single test, so nothing else runs).
 
 mod common;
@@ -45,16 +46,23 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 
 #[test]
 fn steps_after_the_first_do_not_allocate() {
-    for (mode, threads, volume_scheme) in [
-        (ContactMode::ExactShape, 1, VolumeScheme::Tetrahedra),
-        (ContactMode::SampledPoints, 1, VolumeScheme::Tetrahedra),
-        (ContactMode::ExactShape, 2, VolumeScheme::Tetrahedra),
-        (ContactMode::ExactShape, 1, VolumeScheme::DualCells),
+    for (mode, threads, volume_scheme, self_contact) in [
+        (ContactMode::ExactShape, 1, VolumeScheme::Tetrahedra, false),
+        (
+            ContactMode::SampledPoints,
+            1,
+            VolumeScheme::Tetrahedra,
+            false,
+        ),
+        (ContactMode::ExactShape, 2, VolumeScheme::Tetrahedra, false),
+        (ContactMode::ExactShape, 1, VolumeScheme::DualCells, false),
+        (ContactMode::ExactShape, 1, VolumeScheme::Tetrahedra, true),
     ] {
         let settings = Settings {
             contact_mode: mode,
             threads,
             volume_scheme,
+            self_contact,
             ..Settings::default()
         };
         let (mut world, a, b) = two_bodies_stacked(settings);
