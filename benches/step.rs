@@ -5,7 +5,7 @@
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
-//!                             [--times PATH] [--dual-cells]
+//!                             [--times PATH] [--dual-cells] [--self-contact]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -16,7 +16,8 @@
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
 //! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
-//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron.
+//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron;
+//! `--self-contact` switches the surface self-contact on (`Settings::self_contact`).
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -206,12 +207,13 @@ fn run(
     scene: Scene,
     probe: bool,
     steps: usize,
-    (threads, volume_scheme): (u32, VolumeScheme),
+    (threads, volume_scheme, self_contact): (u32, VolumeScheme, bool),
 ) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let settings = Settings {
         threads,
         volume_scheme,
+        self_contact,
         ..Settings::default()
     };
     let mut world = World::new(settings).unwrap();
@@ -308,6 +310,7 @@ fn main() {
     let mut scene_name = "haptic".to_string();
     let mut threads = 1;
     let mut volume_scheme = VolumeScheme::Tetrahedra;
+    let mut self_contact = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -325,6 +328,7 @@ fn main() {
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
             "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
+            "--self-contact" => self_contact = true,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -355,7 +359,7 @@ fn main() {
                 scene(&scene_name),
                 probe,
                 steps,
-                (threads, volume_scheme),
+                (threads, volume_scheme, self_contact),
             );
             let per_k = r.median * 1e3 / r.particles as f64 * 1e3;
             let bpp = r.bytes as f64 / r.particles as f64;
