@@ -2,30 +2,38 @@
 //! is listed in every cell its box (grown by a margin) overlaps, and a point looks in its own
 //! cell only, which holds every triangle whose grown box contains the point.
 //!
-//! The cell side is the largest side of any grown box, so a box overlaps at most 2 × 2 × 2
-//! cells. Cells are hashed into buckets (a power of two, at least twice the triangles) and
-//! sorted by counting sort into flat arrays sized by [`TriangleGrid::reserve`]: no allocation
-//! when it is built again. Built and read on one thread in triangle order: the same lists for
-//! any thread count.
+//! The cell side is the mean side of the grown boxes (their largest side each), but at least a
+//! [`MAX_SPAN`]th of the largest, so that a box overlaps at most `(MAX_SPAN + 1)³` cells; when
+//! the boxes would take more than [`ENTRIES_PER_BOX`] entries each on average the side is
+//! doubled until they fit. Cells are hashed into buckets (a power of two, at least twice the
+//! triangles) and sorted by counting sort into flat arrays sized by [`TriangleGrid::reserve`]:
+//! no allocation when it is built again. Built and read on one thread in triangle order: the
+//! same lists for any thread count.
 
 use crate::math::{Real, Vec3};
 
-/// Most cells one grown triangle box overlaps.
-const CELLS_PER_BOX: usize = 8;
+/// Most cells a grown box spans along an axis, less one (dimensionless).
+const MAX_SPAN: i64 = 3;
+
+/// Entries the grid holds per triangle (dimensionless): the mean number of cells per box it
+/// allows.
+const ENTRIES_PER_BOX: usize = 8;
 
 /// The grid (see the module documentation).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct TriangleGrid {
     /// Cell side (m).
     cell: Real,
+    /// Buckets less one (a power of two less one: a mask).
+    mask: usize,
     /// `start[h]..start[h + 1]` indexes `entries` for bucket `h` (length: buckets + 1).
     start: Vec<u32>,
-    /// Triangle indices sorted by bucket; a triangle is listed once per bucket it reaches.
+    /// Triangle indices sorted by bucket, in triangle order within a bucket; a triangle is
+    /// listed once per cell it overlaps (so twice in a row when two of its cells share a
+    /// bucket).
     entries: Vec<u32>,
     /// Per triangle, its box grown by the margin (m): lower and upper corners.
     boxes: Vec<(Vec3, Vec3)>,
-    /// Per triangle, the buckets of its cells (`u32::MAX` past the last): counting sort scratch.
-    buckets_of: Vec<[u32; CELLS_PER_BOX]>,
 }
 
 impl TriangleGrid {
@@ -35,18 +43,33 @@ impl TriangleGrid {
             return;
         }
         let buckets = (2 * triangles).next_power_of_two().max(64);
+        self.mask = buckets - 1;
         self.start = vec![0; buckets + 1];
-        self.entries = vec![0; CELLS_PER_BOX * triangles];
+        self.entries = vec![0; ENTRIES_PER_BOX * triangles];
         self.boxes = vec![(Vec3::zeros(), Vec3::zeros()); triangles];
-        self.buckets_of = vec![[u32::MAX; CELLS_PER_BOX]; triangles];
+    }
+
+    /// Call `visit` with the bucket of every cell the box `lo`–`hi` (m) overlaps, at most
+    /// `MAX_SPAN + 1` along an axis (fewer only for a box too large for a finite cell side,
+    /// see `build`).
+    #[inline]
+    fn for_each_bucket(&self, (lo, hi): &(Vec3, Vec3), mut visit: impl FnMut(usize)) {
+        let (c0, c1) = (self.cell_of(lo), self.cell_of(hi));
+        for z in c0[2]..=c1[2].min(c0[2].saturating_add(MAX_SPAN)) {
+            for y in c0[1]..=c1[1].min(c0[1].saturating_add(MAX_SPAN)) {
+                for x in c0[0]..=c1[0].min(c0[0].saturating_add(MAX_SPAN)) {
+                    visit(self.bucket([x, y, z]));
+                }
+            }
+        }
     }
 
     #[inline]
-    fn bucket(&self, c: [i64; 3]) -> u32 {
+    fn bucket(&self, c: [i64; 3]) -> usize {
         let h = (c[0].wrapping_mul(73_856_093))
             ^ (c[1].wrapping_mul(19_349_663))
             ^ (c[2].wrapping_mul(83_492_791));
-        ((h as u64 as usize) & (self.start.len() - 2)) as u32
+        (h as u64 as usize) & self.mask
     }
 
     #[inline]
@@ -58,64 +81,78 @@ impl TriangleGrid {
     /// `margin` (m) on every side. Needs [`TriangleGrid::reserve`] for as many triangles.
     pub(crate) fn build(&mut self, positions: &[Vec3], triangles: &[[u32; 3]], margin: Real) {
         let n = triangles.len();
-        let mut side: Real = 0.0;
+        let (mut sum, mut largest): (Real, Real) = (0.0, 0.0);
         for (t, corners) in triangles.iter().enumerate() {
             let [a, b, c] = corners.map(|k| positions[k as usize]);
             let lo = a.inf(&b).inf(&c).add_scalar(-margin);
             let hi = a.sup(&b).sup(&c).add_scalar(margin);
-            side = side.max((hi - lo).max());
-            self.boxes[t] = (lo, hi);
+            self.boxes[t] = if lo.iter().chain(hi.iter()).all(|v| v.is_finite()) {
+                let side = (hi - lo).max();
+                sum += side;
+                largest = largest.max(side);
+                (lo, hi)
+            } else {
+                // A NaN or infinite corner: an empty box (upper below lower), in no cell.
+                (Vec3::repeat(1.0), Vec3::repeat(-1.0))
+            };
         }
-        // A hair above the largest side, so that rounding never lets a box span three cells;
-        // a NaN position makes every comparison false: the cell stays finite and positive.
-        self.cell = if side > 0.0 && side.is_finite() {
-            side * (1.0 + 1.0e-6)
+        // A hair above a MAX_SPAN-th of the largest side, so that rounding never lets a box
+        // span more cells; the cell stays finite and positive when the sum overflows.
+        let floor = largest / MAX_SPAN as Real * (1.0 + 1.0e-6);
+        let mean = sum / n.max(1) as Real;
+        self.cell = if floor > 0.0 && mean.is_finite() {
+            mean.max(floor)
         } else {
             1.0
         };
-        self.start.iter_mut().for_each(|s| *s = 0);
-        for t in 0..n {
-            let (lo, hi) = self.boxes[t];
-            let (c0, c1) = (self.cell_of(&lo), self.cell_of(&hi));
-            let mut mine = [u32::MAX; CELLS_PER_BOX];
-            let mut count = 0;
-            for z in c0[2]..=c1[2].min(c0[2] + 1) {
-                for y in c0[1]..=c1[1].min(c0[1] + 1) {
-                    for x in c0[0]..=c1[0].min(c0[0] + 1) {
-                        let h = self.bucket([x, y, z]);
-                        // Two cells of one box hashed to one bucket: listed once.
-                        if !mine[..count].contains(&h) {
-                            mine[count] = h;
-                            count += 1;
-                            self.start[h as usize + 1] += 1;
-                        }
-                    }
-                }
+        let capacity = ENTRIES_PER_BOX * n;
+        let mut start = std::mem::take(&mut self.start);
+        loop {
+            start.iter_mut().for_each(|s| *s = 0);
+            let mut total = 0;
+            for b in &self.boxes[..n] {
+                self.for_each_bucket(b, |h| {
+                    start[h + 1] += 1;
+                    total += 1;
+                });
             }
-            self.buckets_of[t] = mine;
+            if total <= capacity {
+                break;
+            }
+            // At most twice (from a MAX_SPAN-th of the largest side): above the largest side a
+            // box spans at most 2 × 2 × 2 cells.
+            self.cell *= 2.0;
         }
-        for h in 0..self.start.len() - 1 {
-            self.start[h + 1] += self.start[h];
+        for h in 0..start.len() - 1 {
+            start[h + 1] += start[h];
         }
         // `start[h]` as a moving cursor, shifted back below; each bucket keeps triangle order.
-        for t in 0..n {
-            for &h in self.buckets_of[t].iter().take_while(|&&h| h != u32::MAX) {
-                self.entries[self.start[h as usize] as usize] = t as u32;
-                self.start[h as usize] += 1;
-            }
+        let mut entries = std::mem::take(&mut self.entries);
+        for (t, b) in self.boxes[..n].iter().enumerate() {
+            self.for_each_bucket(b, |h| {
+                entries[start[h] as usize] = t as u32;
+                start[h] += 1;
+            });
         }
-        for h in (1..self.start.len()).rev() {
-            self.start[h] = self.start[h - 1];
+        for h in (1..start.len()).rev() {
+            start[h] = start[h - 1];
         }
-        self.start[0] = 0;
+        start[0] = 0;
+        self.start = start;
+        self.entries = entries;
     }
 
     /// Call `visit` with every triangle whose grown box contains `p` (m), in triangle order,
     /// each once.
     #[inline]
     pub(crate) fn for_each_containing(&self, p: &Vec3, mut visit: impl FnMut(usize)) {
-        let h = self.bucket(self.cell_of(p)) as usize;
+        let h = self.bucket(self.cell_of(p));
+        let mut last = u32::MAX;
         for &t in &self.entries[self.start[h] as usize..self.start[h + 1] as usize] {
+            if t == last {
+                continue;
+            }
+            last = t;
             let (lo, hi) = &self.boxes[t as usize];
             if (0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]) {
                 visit(t as usize);
