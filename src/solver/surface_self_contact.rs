@@ -45,8 +45,10 @@
 //! grown by `s` plus twice the largest motion of a boundary vertex in the substep, up to a
 //! particle radius (so that a vertex that crossed a triangle within the substep is in its
 //! box); each boundary vertex looks
-//! in its own cell. It costs one pass over the boundary triangles and a few box tests per
-//! boundary vertex, most of which (the triangles around it) condition 1 or 2 turn away.
+//! in its own cell, and not even there when its normal is within 90° of the cone of the cell's
+//! triangle normals (condition 2 would turn all of them away). It costs one pass over the
+//! boundary triangles and over the grid's cells, and a few box tests per boundary vertex not
+//! skipped, most of which (the triangles around it) condition 1 or 2 turn away.
 //! Everything runs on the calling thread, the
 //! vertices in increasing order and the triangles of a cell in boundary order: the same bits
 //! for any thread count.
@@ -136,12 +138,16 @@ pub(crate) fn project_self_contacts(
         .fold(0.0, Real::max)
         .sqrt()
         .min(model.particle_radius);
-    grid.build(p, boundary, skin + 2.0 * motion);
+    grid.build(p, boundary, normal, skin + 2.0 * motion);
     for &i in &model.boundary_vertices {
         let i = i as usize;
         let facing = vertex_normal[i];
+        // A zero normal faces no triangle (condition 2).
+        let Some(direction) = facing.try_normalize(0.0) else {
+            continue;
+        };
         let query = p[i];
-        grid.for_each_containing(&query, |t| {
+        grid.for_each_containing(&query, &direction, |t| {
             let n = normal[t];
             if boundary[t].contains(&(i as u32)) || n.dot(&facing) >= 0.0 {
                 return;
