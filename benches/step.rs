@@ -5,7 +5,7 @@
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
-//!                             [--times PATH] [--dual-cells] [--tetrahedra]
+//!                             [--times PATH] [--dual-cells] [--tetrahedra] [--self-contact]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -18,6 +18,7 @@
 //! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
 //! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron;
 //! `--tetrahedra` the elasticity on corotated tetrahedra (`ElasticScheme::Tetrahedra`).
+//! `--self-contact` switches the surface self-contact on (`Settings::self_contact`).
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -299,6 +300,7 @@ fn main() {
     let mut threads = 1;
     let mut volume_scheme = VolumeScheme::Tetrahedra;
     let mut elastic_scheme = ElasticScheme::PointBased;
+    let mut self_contact = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -317,6 +319,7 @@ fn main() {
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
             "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
             "--tetrahedra" => elastic_scheme = ElasticScheme::Tetrahedra,
+            "--self-contact" => self_contact = true,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -351,6 +354,7 @@ fn main() {
                     threads,
                     volume_scheme,
                     elastic_scheme,
+                    self_contact,
                     ..Settings::default()
                 },
             );

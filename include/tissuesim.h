@@ -206,7 +206,9 @@ typedef struct ts_settings {
      */
     uint8_t volume_constraints;
     /**
-     * Contact between particles of the same body: 0 off, non-zero on.
+     * Surface self-contact: each body's boundary vertices kept a skin of half a particle
+     * radius in front of its own boundary triangles, so that folds and the faces of a cut do
+     * not pass through each other: 0 off (the default), non-zero on.
      */
     uint8_t self_contact;
     /**

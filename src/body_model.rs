@@ -39,6 +39,8 @@ pub struct BodyModel {
     pub(crate) tet_rest_volume: Vec<Real>,
     /// Boundary triangles, outward normals.
     pub(crate) boundary: Vec<[u32; 3]>,
+    /// The particles at the boundary triangles' corners, each once, increasing.
+    pub(crate) boundary_vertices: Vec<u32>,
     /// Contact radius of the particles (m).
     pub(crate) particle_radius: Real,
     /// Centre of the rest bounding box (m).
@@ -137,6 +139,7 @@ impl BodyModel {
             rest_volume: tet_rest_volume.iter().sum(),
             tet_rest_volume,
             tets: mesh.tets.clone(),
+            boundary_vertices: crate::mesh::boundary_vertices(&boundary),
             boundary,
             particle_radius: options
                 .particle_radius
@@ -202,6 +205,7 @@ impl BodyModel {
             + size_of_val(self.tets.as_slice())
             + size_of_val(self.tet_rest_volume.as_slice())
             + size_of_val(self.boundary.as_slice())
+            + size_of_val(self.boundary_vertices.as_slice())
             + size_of_val(n.offsets.as_slice())
             + size_of_val(n.ends.as_slice())
             + size_of_val(n.index.as_slice())

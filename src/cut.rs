@@ -245,6 +245,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
         tets: model.tets.clone(),
     };
     model.boundary = mesh.boundary_triangles();
+    model.boundary_vertices = crate::mesh::boundary_vertices(&model.boundary);
     restabilise(body, &state);
     body.cuts = Some(state);
     isolated

@@ -131,7 +131,13 @@ pub struct Settings {
     /// (PhysX's `maxDepenetrationVelocity`), while the tool pushes the tissue at its own speed
     /// and tissue that moves into a tool is stopped whole.
     pub max_depenetration_speed: Real,
-    /// Enable contact between particles of the same body (off by default).
+    /// Surface self-contact (off by default, see docs/SETTINGS.md): each body's boundary
+    /// vertices are kept a skin of half a particle radius in front of the body's other boundary
+    /// triangles (one-sided, with the body's own pair friction, see
+    /// [`World::set_body_pair_friction`](crate::World::set_body_pair_friction)), so that folds,
+    /// a dent closing on itself and the faces of a cut do not pass through each other. The
+    /// triangles around a vertex and pairs closer than the skin at rest are not in contact.
+    /// Off, a body passes through itself.
     pub self_contact: bool,
     /// Threads a step runs on (≥ 1): the calling thread plus `threads - 1` workers owned by
     /// the world, sharing the force, volume, prediction and update passes (tool contacts stay

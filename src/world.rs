@@ -329,7 +329,10 @@ impl World {
             return Err(Error::NonFinite("blade edge".into()));
         }
         self.body(id)?;
-        Ok(crate::cut::cut(&mut self.bodies[id.0 as usize], blade))
+        let report = crate::cut::cut(&mut self.bodies[id.0 as usize], blade);
+        let models = self.bodies.iter().map(|b| &*b.model);
+        self.workspace.fit_boundaries(models);
+        Ok(report)
     }
     /// Make tool `id` (a capsule or a cylinder) a blade: its edge is the segment of its local y
     /// axis between ±half_height; at the end of every step it cuts every body along the surface

@@ -257,6 +257,8 @@ impl World {
             }
             body.state.assign(&s.particles);
         }
+        let models = self.bodies.iter().map(|b| &*b.model);
+        self.workspace.fit_boundaries(models);
         for (slot, s) in self.tools.iter_mut().flatten().zip(&state.tools) {
             let (tool, grasp, needle) = (&mut slot.tool, &mut slot.grasp, &mut slot.needle);
             (tool.pose, tool.target, tool.linear_velocity, tool.wrench) =

@@ -1,5 +1,6 @@
 //! No heap allocation inside a step after the first: two bodies in organ–organ contact, a probe
-//! with friction pressing one of them, in both contact modes, on one and on two threads. Every
+//! with friction pressing one of them, in both contact modes, on one and on two threads, and
+//! with surface self-contact. Every
 //! thread's allocations are counted (this file holds a single test, so nothing else runs).
 
 mod common;
@@ -7,7 +8,9 @@ mod common;
 use common::two_bodies_stacked;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use tissuesim::{ContactMode, Pose, Settings, ToolOptions, ToolShape, Vec3, VolumeScheme};
+use tissuesim::{
+    ContactMode, ElasticScheme, Pose, Settings, ToolOptions, ToolShape, Vec3, VolumeScheme,
+};
 
 struct Counting;
 
@@ -45,17 +48,49 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 
 #[test]
 fn steps_after_the_first_do_not_allocate() {
-    for (mode, threads, volume_scheme) in [
-        (ContactMode::ExactShape, 1, VolumeScheme::Tetrahedra),
-        (ContactMode::SampledPoints, 1, VolumeScheme::Tetrahedra),
-        (ContactMode::ExactShape, 2, VolumeScheme::Tetrahedra),
-        (ContactMode::ExactShape, 1, VolumeScheme::DualCells),
-        (ContactMode::ExactShape, 2, VolumeScheme::DualCells),
+    // (contact mode, threads, volume scheme, elastic scheme, self-contact)
+    use ElasticScheme::{PointBased, Tetrahedra};
+    use VolumeScheme::DualCells;
+    for (mode, threads, volume_scheme, elastic_scheme, self_contact) in [
+        (
+            ContactMode::ExactShape,
+            1,
+            VolumeScheme::Tetrahedra,
+            PointBased,
+            false,
+        ),
+        (
+            ContactMode::SampledPoints,
+            1,
+            VolumeScheme::Tetrahedra,
+            PointBased,
+            false,
+        ),
+        (
+            ContactMode::ExactShape,
+            2,
+            VolumeScheme::Tetrahedra,
+            PointBased,
+            false,
+        ),
+        (ContactMode::ExactShape, 1, DualCells, PointBased, false),
+        (ContactMode::ExactShape, 2, DualCells, PointBased, false),
+        (ContactMode::ExactShape, 1, DualCells, Tetrahedra, false),
+        (ContactMode::ExactShape, 2, DualCells, Tetrahedra, false),
+        (
+            ContactMode::ExactShape,
+            1,
+            VolumeScheme::Tetrahedra,
+            PointBased,
+            true,
+        ),
     ] {
         let settings = Settings {
             contact_mode: mode,
             threads,
             volume_scheme,
+            elastic_scheme,
+            self_contact,
             ..Settings::default()
         };
         let (mut world, a, b) = two_bodies_stacked(settings);

@@ -182,7 +182,7 @@ pub struct Settings {
     pub contact_mode: ContactMode,
     /// Largest speed (m/s) at which contact removes a penetration already there. Default 1.
     pub max_depenetration_speed: Real,
-    /// Contact between particles of the same body. Default False.
+    /// Surface self-contact: a body's boundary kept off its own boundary triangles. Default False.
     pub self_contact: bool,
     /// Threads a step runs on (1..=64); the same bits for any count. Default 1.
     pub threads: u32,

@@ -57,7 +57,9 @@ pub struct ts_settings {
     pub contact_mode: u32,
     /// Per-tetrahedron volume constraints: 0 off, non-zero on.
     pub volume_constraints: u8,
-    /// Contact between particles of the same body: 0 off, non-zero on.
+    /// Surface self-contact: each body's boundary vertices kept a skin of half a particle
+    /// radius in front of its own boundary triangles, so that folds and the faces of a cut do
+    /// not pass through each other: 0 off (the default), non-zero on.
     pub self_contact: u8,
     /// Selective mass scaling: 0 off, non-zero on (the default). Particles whose own stable
     /// time step is shorter than dt / min_substeps get extra inertial mass (not extra weight)

@@ -55,6 +55,14 @@ pub(crate) fn boundary_triangles(mesh: &TetMesh) -> Vec<[u32; 3]> {
         .collect()
 }
 
+/// The particles at the corners of `boundary` triangles, each once, increasing.
+pub(crate) fn boundary_vertices(boundary: &[[u32; 3]]) -> Vec<u32> {
+    let mut vertices: Vec<u32> = boundary.iter().flatten().copied().collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

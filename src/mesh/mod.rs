@@ -10,6 +10,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 mod boundary;
+pub(crate) use boundary::boundary_vertices;
 mod clean;
 mod gmsh;
 mod lattice;

@@ -32,10 +32,12 @@ mod organ_contact;
 mod predict;
 mod sampled_contact;
 mod surface_contact;
+mod surface_self_contact;
 mod volume;
 mod workspace;
 
 pub(crate) use surface_contact::SurfaceScratch;
+pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::body::{volume_on, Body};
@@ -148,6 +150,10 @@ impl World {
                 cut.isolated += r.isolated;
             }
         }
+        if cut.tets > 0 {
+            let models = self.bodies.iter().map(|b| &*b.model);
+            self.workspace.fit_boundaries(models);
+        }
         let dt = self.settings.dt;
         for slot in self.tools.iter_mut().flatten() {
             let (t, load) = (&mut slot.tool, &slot.load);
@@ -184,7 +190,7 @@ impl World {
         for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter_mut()) {
             predict::predict(body, scratch, gravity, h, alpha_damp, &self.pool);
         }
-        let organ_contact = self.bodies.len() > 1 || s.self_contact;
+        let organ_contact = self.bodies.len() > 1;
         if organ_contact {
             let cell = 2.0
                 * self
@@ -234,8 +240,21 @@ impl World {
                     &self.bodies,
                     scratch,
                     &self.pair_friction,
-                    self.settings.self_contact,
                 );
+            }
+            if self.settings.self_contact {
+                for (b, (body, scratch)) in self.bodies.iter().zip(scratch.iter_mut()).enumerate() {
+                    let own = (b as u32, b as u32);
+                    let friction = (self.pair_friction.iter().find(|f| f.bodies == own))
+                        .map_or((0.0, 0.0), |f| (f.mu_s, f.mu_k));
+                    surface_self_contact::project_self_contacts(
+                        &mut self.workspace.self_contact,
+                        body,
+                        scratch,
+                        friction,
+                        self.settings.max_depenetration_speed * h,
+                    );
+                }
             }
             let mode = self.settings.contact_mode;
             let max_correction = self.settings.max_depenetration_speed * h;

@@ -1,5 +1,6 @@
-//! Organ–organ contact: particle spheres of different bodies (or of one body far apart at rest)
-//! pushed apart, with body-pair friction.
+//! Organ–organ contact: particle spheres of different bodies pushed apart, with body-pair
+//! friction. (Contact of a body with itself is the surface self-contact,
+//! `crate::solver::surface_self_contact`.)
 
 use crate::body::Body;
 use crate::collision::hash_grid::HashGrid;
@@ -13,18 +14,17 @@ use crate::world::PairFriction;
 /// fixed-size array: the step allocates nothing).
 const BOUNDED_BODIES: usize = 16;
 
-/// One Gauss–Seidel pass over the particle–particle contacts between bodies (and within a body
-/// when `self_contact`), found through `grid` (built on the predicted positions, in `scratch`), with the
-/// body-pair friction of `pair_friction`.
+/// One Gauss–Seidel pass over the particle–particle contacts between bodies, found through
+/// `grid` (built on the predicted positions, in `scratch`), with the body-pair friction of
+/// `pair_friction`.
 pub(crate) fn project_organ_contacts(
     grid: &HashGrid,
     bodies: &[Body],
     scratch: &mut [StepScratch],
     pair_friction: &[PairFriction],
-    self_contact: bool,
 ) {
     let nb = bodies.len();
-    // Without self-contact only particles near another body can touch: each body's bounding
+    // Only particles near another body can touch: each body's bounding
     // box of its predicted positions, grown by every write of the pass (so it always holds
     // them all), lets a particle farther than the contact distance from every other body's box
     // skip the grid query. It skips only pairs that cannot touch: the same projections in the
@@ -34,7 +34,7 @@ pub(crate) fn project_organ_contacts(
         Vec3::repeat(Real::INFINITY),
         Vec3::repeat(Real::NEG_INFINITY),
     ); BOUNDED_BODIES];
-    let bounded = !self_contact && nb <= BOUNDED_BODIES;
+    let bounded = nb <= BOUNDED_BODIES;
     if bounded {
         for (b, s) in scratch.iter().enumerate() {
             bounds[b] =
@@ -62,18 +62,11 @@ pub(crate) fn project_organ_contacts(
             let friction = pair_friction;
             grid.for_each_near(&pi, |[b, j]| {
                 let (b, j) = (b as usize, j as usize);
-                if (b, j) <= (a, i) || (a == b && !self_contact) {
+                if b <= a {
                     return;
                 }
                 let ra = bodies[a].model.particle_radius;
                 let rb = bodies[b].model.particle_radius;
-                if a == b {
-                    // Particles close at rest belong to the same piece of tissue.
-                    let rest_d = (bodies[a].model.rest[i] - bodies[a].model.rest[j]).norm();
-                    if rest_d < 2.0 * (ra + rb) {
-                        return;
-                    }
-                }
                 let (wa, wb) = (bodies[a].inv_mass[i], bodies[b].inv_mass[j]);
                 let (mut pa, mut pb) = (scratch[a].p[i], scratch[b].p[j]);
                 let Some(c) = project_particle_particle(&mut pa, &mut pb, wa, wb, ra + rb) else {

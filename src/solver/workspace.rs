@@ -8,7 +8,7 @@ use crate::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
 use crate::math::{Real, Vec3};
 use crate::particles::ParticleView;
-use crate::solver::SurfaceScratch;
+use crate::solver::{SelfContactScratch, SurfaceScratch};
 use crate::world_state::WorldState;
 
 /// A body's working memory of a step; nothing in it outlives a substep.
@@ -107,6 +107,8 @@ pub(crate) struct Workspace {
     pub(crate) grid: HashGrid,
     /// Scratch memory of the tool–surface contact pass.
     pub(crate) surface: SurfaceScratch,
+    /// Scratch memory of the surface self-contact pass, sized for the largest body.
+    pub(crate) self_contact: SelfContactScratch,
     /// The state at the start of the step in progress, put back if the step diverges.
     pub(crate) rollback: WorldState,
 }
@@ -117,6 +119,16 @@ impl Workspace {
         self.bodies.push(StepScratch::for_model(model, threads));
         let particles = self.bodies.iter().map(|s| s.p.len()).sum();
         self.grid.reserve(particles);
+        self.self_contact.reserve(model);
+    }
+
+    /// Size the surface self-contact scratch for bodies on `models` after a change of
+    /// topology (a cut or a restored cut state changes a boundary): the step after it then
+    /// allocates nothing.
+    pub(crate) fn fit_boundaries<'a>(&mut self, models: impl Iterator<Item = &'a BodyModel>) {
+        for model in models {
+            self.self_contact.reserve(model);
+        }
     }
 
     /// Size every body's scratch (the bodies on `models`, in order) for `threads` threads.
