@@ -23,10 +23,11 @@
 //! Unlike the particles' nodal integration, a tetrahedron has no zero-energy mode: no
 //! hourglass control is needed (the hourglass setting does not apply).
 //!
-//! The pass runs in two halves on the pool. First each share of the tetrahedra computes their
-//! corner forces, four tetrahedra a lane, into one slot per corner; after a barrier each share
-//! of the particles sums its particles' corner slots in tetrahedron order. Every force is so
-//! summed in one order: the result is bit-identical for any number of threads.
+//! The pass takes the tetrahedra four at a time, one a lane. On one thread each chunk's corner
+//! forces go straight to the particles; on several it runs in two halves on the pool: each
+//! share of the chunks writes one slot per corner, and after a barrier each share of the
+//! particles sums its particles' slots in tetrahedron order. Every particle's force is so
+//! summed in tetrahedron order: the result is bit-identical for any number of threads.
 
 use crate::elastic::{corotated_stress, ElasticModel};
 use crate::lanes::{F4, LANES, M4, V4};
