@@ -150,7 +150,7 @@ class Settings:
     max_depenetration_speed: float
     """Largest speed (m/s) at which contact removes a penetration already there. Default 1."""
     self_contact: bool
-    """Surface self-contact: a body's boundary kept off its own boundary triangles. Default False."""
+    """Surface self-contact: a body's boundary kept off its own triangles. Default False."""
     threads: int
     """Threads a step runs on (1..=64); bit-identical results for any count. Default 1."""
     divergence: DivergenceLimits
