@@ -519,7 +519,6 @@ impl Body {
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
         let mut force = vec![Vec3::zeros(); self.state.x.len()];
         if self.elastic_scheme == ElasticScheme::Tetrahedra {
-            let mut corners = vec![Vec3::zeros(); 4 * self.model.tets.len()];
             let at_rest = vec![Vec3::zeros(); positions.len()];
             let input = TetForceInputs {
                 elements: &self.model.tet_elements,
@@ -527,10 +526,11 @@ impl Body {
                 v: &at_rest,
                 fixed: &[],
             };
+            // One thread keeps no corner forces.
             tet_elasticity::accumulate_forces(
                 &self.elastic,
                 &input,
-                &mut corners,
+                &mut [],
                 &mut force,
                 &Pool::new(1),
             );

@@ -250,17 +250,17 @@ pub(crate) fn project_tool_surface(
                 // this substep. Tissue moving into the tool is stopped whole, the tool pushes the
                 // tissue at its own speed, and penetration older than this substep is removed at
                 // `max_depenetration_speed` (never faster, however many substeps and triangles
-                // push). What the cap leaves in the first pass stays for the next substeps; the
-                // later passes remove what the neighbouring triangles' corrections pushed in beyond
-                // it, each under the same cap.
+                // push). What the cap leaves in the first pass the later passes do not retry
+                // (they remove what the neighbouring triangles' corrections pushed in beyond it,
+                // each under the same cap); the second round does (`SURFACE_ROUNDS`).
                 let depth = contact.depth;
                 let tool_motion = tool_motion_at(&back, &contact.point);
                 let pushed = tool_motion.dot(&contact.direction).max(0.0);
                 let budget = max_correction + pushed;
                 let mut cap = (budget - moved.dot(&contact.direction)).max(0.0);
+                let shares = corner_shares(&weights, &w);
                 if round > 0 {
                     // The retry keeps every corner within the budget too.
-                    let shares = corner_shares(&weights, &w);
                     for k in 0..3 {
                         if shares[k] > 0.0 {
                             let own = view.p[corners[k]] - view.x[corners[k]];
@@ -282,7 +282,6 @@ pub(crate) fn project_tool_surface(
                 let relative = moved + normal_shift - tool_motion;
                 let shift = normal_shift
                     + friction_correction(&relative, &contact.direction, applied, mu_s, mu_k);
-                let shares = corner_shares(&weights, &w);
                 // What the cap on the shares keeps the contact point from achieving stays as
                 // residual penetration, like the depenetration cap's: not retried in the later passes.
                 let achieved: Real = (0..3).map(|k| weights[k] * shares[k]).sum();
