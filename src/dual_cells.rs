@@ -39,24 +39,15 @@ impl DualCells {
     /// The cells of `n` particles from the tetrahedra `tets` and their rest volumes (m³).
     /// Panics if a star holds more than 65,535 particles (no tetrahedral mesh comes near).
     pub(crate) fn new(tets: &[[u32; 4]], tet_rest_volume: &[Real], n: usize) -> Self {
-        let mut offsets = vec![0u32; n + 1];
-        for tet in tets {
-            tet.iter().for_each(|&k| offsets[k as usize + 1] += 1);
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        // Each particle's tetrahedra, and its corner among their four.
-        let mut next = offsets.clone();
-        let mut around = vec![(0u32, 0usize); offsets[n] as usize];
-        let mut rest_volume = vec![0.0; n];
-        for (t, tet) in tets.iter().enumerate() {
-            for (c, &k) in tet.iter().enumerate() {
-                around[next[k as usize] as usize] = (t as u32, c);
-                next[k as usize] += 1;
-                rest_volume[k as usize] += 0.25 * tet_rest_volume[t];
-            }
-        }
+        // Each particle's tetrahedra, and its corner among their four (slot 4 t + c).
+        let (offsets, around) = crate::mesh::incidence::corners_around(tets, n);
+        let rest_volume = (0..n)
+            .map(|i| {
+                let mine = &around[offsets[i] as usize..offsets[i + 1] as usize];
+                mine.iter()
+                    .fold(0.0, |v, &s| v + 0.25 * tet_rest_volume[s as usize / 4])
+            })
+            .collect();
         let mut opposite = vec![[0u16; 3]; around.len()];
         let mut star_offsets = Vec::with_capacity(n + 1);
         let mut star = Vec::new();
@@ -65,7 +56,7 @@ impl DualCells {
             let first = star.len();
             star.push(i as u32);
             for e in offsets[i] as usize..offsets[i + 1] as usize {
-                let (t, c) = around[e];
+                let (t, c) = (around[e] / 4, around[e] as usize % 4);
                 for (o, &k) in opposite[e].iter_mut().zip(&OTHERS[c]) {
                     let k = tets[t as usize][k];
                     let slot = match star[first..].iter().position(|&j| j == k) {

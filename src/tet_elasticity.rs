@@ -81,24 +81,7 @@ impl TetElements {
                 }
             })
             .collect();
-        let mut count = vec![0u32; n + 1];
-        for tet in tets {
-            for &k in tet {
-                count[k as usize + 1] += 1;
-            }
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let corner_offsets = count.clone();
-        let mut corners = vec![0; tets.len() * 4];
-        for (t, tet) in tets.iter().enumerate() {
-            for (c, &k) in tet.iter().enumerate() {
-                let at = &mut count[k as usize];
-                corners[*at as usize] = (4 * t + c) as u32;
-                *at += 1;
-            }
-        }
+        let (corner_offsets, corners) = crate::mesh::incidence::corners_around(tets, n);
         TetElements {
             count: tets.len(),
             chunks,

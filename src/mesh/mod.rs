@@ -13,6 +13,7 @@ mod boundary;
 pub(crate) use boundary::boundary_vertices;
 mod clean;
 mod gmsh;
+pub(crate) mod incidence;
 mod lattice;
 mod obj;
 mod organ;
