@@ -51,6 +51,9 @@ pub(crate) mod rotation;
 pub(crate) mod settings;
 pub(crate) mod solver;
 pub(crate) mod stability;
+// The saved-state byte format: public as `tissuesim::state`, in a file whose name says what it
+// holds (the state as a value is `world_state`).
+#[path = "saved_state.rs"]
 pub mod state;
 pub mod statics;
 pub(crate) mod tet_elasticity;
