@@ -48,18 +48,18 @@ pub(crate) mod particle_order;
 pub(crate) mod particles;
 pub mod render;
 pub(crate) mod rotation;
+pub(crate) mod scene;
 pub(crate) mod settings;
 pub(crate) mod solver;
 pub(crate) mod stability;
 // The saved-state byte format: public as `tissuesim::state`, in a file whose name says what it
-// holds (the state as a value is `world_state`).
+// holds (the state as a value is `scene::state`).
 #[path = "saved_state.rs"]
 pub mod state;
 pub mod statics;
 pub(crate) mod tet_elasticity;
 pub(crate) mod vec3_array;
 pub(crate) mod world;
-pub(crate) mod world_state;
 
 pub use body::{
     Body, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
@@ -78,6 +78,6 @@ pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use needle::{NeedleOptions, NeedleState};
 pub use neighbours::MAX_NEIGHBOURS;
 pub use particle_order::ParticleOrder;
+pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
 pub use settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
-pub use world::{BodyId, RenderSurfaceId, StepReport, ToolId, World, TOOL_JUMP_FRACTION};
-pub use world_state::WorldState;
+pub use world::{RenderSurfaceId, World};

@@ -28,6 +28,9 @@
 //! Reading ([`WorldState::from_bytes`]) needs no world: it checks the magic, the version, the
 //! checksum and that every count fits in the bytes before it allocates;
 //! [`World::set_state`] then checks the values against the world.
+//!
+//! [`World::state_size`]: crate::World::state_size
+//! [`World::set_state`]: crate::World::set_state
 
 use crate::body::ParticleState;
 use crate::collision::tool::{Pose, Wrench};
@@ -35,11 +38,10 @@ use crate::error::Error;
 use crate::grasp::{Attachment, Grasp};
 use crate::math::{Quat, Real, Vec3};
 use crate::needle::ShaftHold;
-use crate::world::World;
-use crate::world_state::{BodyState, NeedleInsertion, ToolState, WorldState};
+use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use std::sync::Arc;
 
-/// Version of the byte format written by [`World::save_state`].
+/// Version of the byte format written by [`World::save_state`](crate::World::save_state).
 pub const STATE_VERSION: u32 = 5;
 
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
@@ -141,7 +143,7 @@ impl<'a> Reader<'a> {
 
 /// Bytes of a state of `bodies` (particle count, cut entries of each) and `tools` (grasp
 /// attachments, needle holds of each).
-fn layout_size(
+pub(crate) fn layout_size(
     bodies: impl Iterator<Item = (usize, usize)>,
     tools: impl Iterator<Item = (usize, usize)>,
 ) -> usize {
@@ -222,8 +224,8 @@ impl WorldState {
 
     /// Read a state written by [`WorldState::to_bytes`]. Checks the magic bytes, the version,
     /// the checksum and the layout (every count within the bytes, nothing left over); the
-    /// values are checked against a world by [`World::set_state`]. [`Error::BadState`] says
-    /// what is wrong.
+    /// values are checked against a world by [`World::set_state`](crate::World::set_state).
+    /// [`Error::BadState`] says what is wrong.
     pub fn from_bytes(bytes: &[u8]) -> Result<WorldState, Error> {
         let bad = |m: &str| Err(Error::BadState(m.to_string()));
         if bytes.len() < HEADER + 8 || &bytes[..8] != MAGIC {
@@ -327,35 +329,5 @@ impl WorldState {
             bodies,
             tools,
         })
-    }
-}
-
-impl World {
-    /// Size in bytes of the state [`World::save_state`] writes now (computed from the world,
-    /// without taking its state).
-    pub fn state_size(&self) -> usize {
-        let bodies = self.bodies.iter().map(|b| {
-            let cuts = crate::cut::cut_sets(b).map_or(0, |c| c.0.len() + c.1.len());
-            (b.particle_count(), cuts)
-        });
-        let tools = (self.tools.iter().flatten()).map(|s| {
-            let holds = s.needle.as_ref().map_or(0, |n| n.holds.len());
-            (s.grasp.attachments.len(), holds)
-        });
-        layout_size(bodies, tools)
-    }
-
-    /// Append the world's dynamic state ([`World::state`]) to `out` in the format of
-    /// [`crate::state`].
-    pub fn save_state(&self, out: &mut Vec<u8>) {
-        out.reserve(self.state_size());
-        self.state().to_bytes(out);
-    }
-
-    /// Restore a state written by [`World::save_state`] of a world built the same way:
-    /// [`WorldState::from_bytes`] then [`World::set_state`]. On any error the world is left
-    /// unchanged and [`Error::BadState`] says why.
-    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<(), Error> {
-        self.set_state(&WorldState::from_bytes(bytes)?)
     }
 }

@@ -12,7 +12,7 @@ use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::math::Vec3;
 use crate::mesh::{self, TetMesh};
-use crate::world::BodyId;
+use crate::scene::BodyId;
 use std::ffi::{c_char, CStr};
 use std::mem::MaybeUninit;
 use std::path::{Path, PathBuf};

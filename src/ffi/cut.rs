@@ -7,7 +7,7 @@ use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::math::Vec3;
-use crate::world::{BodyId, ToolId};
+use crate::scene::{BodyId, ToolId};
 
 /// What a cut removed.
 #[repr(C)]

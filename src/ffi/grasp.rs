@@ -5,7 +5,7 @@ use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::grasp::GraspOptions;
-use crate::world::ToolId;
+use crate::scene::ToolId;
 
 /// How a tool grasps. ts_grasp_options_default gives automatic reach and compliance and a grasp
 /// that never slips.

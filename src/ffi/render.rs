@@ -9,7 +9,8 @@ use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::math::Vec3;
 use crate::render::{read_obj, RenderMesh, RenderSurface};
-use crate::world::{BodyId, RenderSurfaceId};
+use crate::scene::BodyId;
+use crate::world::RenderSurfaceId;
 use std::ffi::c_char;
 use std::mem::MaybeUninit;
 

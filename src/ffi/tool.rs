@@ -11,7 +11,7 @@ use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::math::Vec3;
 use crate::mesh;
-use crate::world::ToolId;
+use crate::scene::ToolId;
 use std::ffi::c_char;
 
 /// A rigid pose in the world frame: the position of the tool origin and its orientation.

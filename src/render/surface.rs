@@ -6,7 +6,7 @@ use super::mesh::RenderMesh;
 use crate::body::Body;
 use crate::error::Error;
 use crate::math::{Real, Vec3};
-use crate::world::BodyId;
+use crate::scene::BodyId;
 use std::path::Path;
 
 /// A render mesh bound once to the rest tetrahedra of a body.

@@ -1,12 +1,15 @@
-//! The step: [`World::step`] runs Algorithm 1 of the paper as a sequence of passes, one file
-//! each.
+//! The step: [`Pipeline::step`] runs Algorithm 1 of the paper on a [`Scene`] as a sequence of
+//! passes, one file each. The pipeline owns only what a step uses and throws away (the
+//! [`Workspace`], the rollback copy included) and the thread pool; everything the step advances
+//! is the scene's (rapier's `PhysicsPipeline`, MuJoCo's model/data split).
 //!
 //! One step of `dt` is split into `n` substeps of `h = dt / n` (`n` from the explicit stability
-//! limit of the stiffest body, at least `Settings::min_substeps`). Data flow of one step:
+//! limit of the stiffest body, at least `Settings::min_substeps`: `Scene::substeps_needed`).
+//! Data flow of one step:
 //!
-//! 1. copy the world's state (one [`WorldState`](crate::WorldState) value: particles, fixed
-//!    flags, cuts, tools, grasps, needle holds, time) into the workspace's rollback copy; clear
-//!    the tools' wrench accumulators;
+//! 1. copy the scene's state (one [`WorldState`](crate::WorldState) value: particles, fixed
+//!    flags, cuts, tools, grasps, needle holds, time) into the workspace's rollback copy
+//!    (`Scene::state_into`); clear the tools' wrench accumulators;
 //! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
@@ -16,17 +19,18 @@
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
 //! 3. the divergence check (`crate::divergence`): a failure puts the rollback copy back
-//!    (`World::apply_state`, the code `World::set_state` uses after its checks);
+//!    (`Scene::apply_state`, the code `Scene::set_state` uses after its checks);
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
 //!    poses, needle puncture or withdrawal, time.
 //!
-//! Tools move from their previous pose to the pose set by [`World::set_tool_pose`] across the
-//! substeps (linear position, slerp orientation); a tool faster than
-//! [`World::tool_jump_speed`] is placed at its new pose at once (a jump; blades excepted). The
-//! passes read the bodies (model and state) and write the [`Workspace`] (per body a
-//! `StepScratch`: predicted positions `p`, forces, multipliers; the hash grid; the
-//! surface-contact scratch; the rollback copy); only the prediction (velocities, rotations) and
-//! the final update (`v = (p − x)/h`, `x = p`) write the bodies' state.
+//! Tools move from their previous pose to the pose set by
+//! [`World::set_tool_pose`](crate::World::set_tool_pose) across the substeps (linear position,
+//! slerp orientation); a tool faster than
+//! [`World::tool_jump_speed`](crate::World::tool_jump_speed) is placed at its new pose at once
+//! (a jump; blades excepted). The passes read the scene's bodies (model and state) and write the
+//! [`Workspace`] (per body a `StepScratch`: predicted positions `p`, forces, multipliers; the
+//! hash grid; the surface-contact scratch; the rollback copy); only the prediction (velocities,
+//! rotations) and the final update (`v = (p − x)/h`, `x = p`) write the bodies' state.
 
 mod organ_contact;
 mod predict;
@@ -41,15 +45,16 @@ pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::body::{volume_on, Body};
+use crate::body_model::BodyModel;
 use crate::collision::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
 use crate::error::Error;
 use crate::math::{Real, Vec3};
-use crate::parallel::SharedSlice;
+use crate::parallel::{Pool, SharedSlice};
 use crate::particles::{ParticleView, ParticleViews};
+use crate::scene::{Scene, StepReport, ToolSlot};
 use crate::settings::{ContactMode, VolumeScheme, MAX_THREADS};
-use crate::world::{StepReport, ToolSlot, World};
 use parry3d_f64::math::{Isometry, Point};
 
 /// The bodies' particle views over their step scratch, by body index.
@@ -70,35 +75,78 @@ fn tool_motion_at(back: &Isometry<Real>, point: &Vec3) -> Vec3 {
     point - back.transform_point(&Point::from(*point)).coords
 }
 
-impl World {
-    /// Advance the world by `settings.dt`. When a body becomes non-finite or leaves the
-    /// physical bounds of [`Settings::divergence`](crate::Settings::divergence) the world is rolled back to the start of the
-    /// step and [`Error::Diverged`] says which body and why.
-    pub fn step(&mut self) -> Result<StepReport, Error> {
-        let (n, clamped) = self.substeps_needed();
+/// The step's machinery: the scratch memory of a step and the threads, no scene. Sized for the
+/// bodies of the scene it steps as they are added (and after a cut), so that
+/// [`Pipeline::step`] allocates nothing.
+pub(crate) struct Pipeline {
+    /// All the memory a step uses and throws away, the rollback copy included.
+    pub(crate) workspace: Workspace,
+    /// The threads of the force, volume, prediction and update passes.
+    pool: Pool,
+}
+
+impl Pipeline {
+    /// A pipeline with no body, stepping on `threads` threads.
+    pub(crate) fn new(threads: u32) -> Pipeline {
+        Pipeline {
+            workspace: Workspace::default(),
+            pool: Pool::new(threads as usize),
+        }
+    }
+
+    /// The pipeline's threads.
+    pub(crate) fn pool(&self) -> &Pool {
+        &self.pool
+    }
+
+    /// Make room for one more body of the scene, on `model`.
+    pub(crate) fn add_body(&mut self, model: &BodyModel) {
+        self.workspace.add_body(model, self.pool.threads());
+    }
+
+    /// Step on `threads` threads from now on, the scratch of the scene's `bodies` resized.
+    pub(crate) fn set_threads(&mut self, threads: u32, bodies: &[Body]) {
+        self.pool = Pool::new(threads as usize);
+        let models = bodies.iter().map(|b| &*b.model);
+        self.workspace.set_threads(models, self.pool.threads());
+    }
+
+    /// Size the scratch for the scene's `bodies` after a change of topology (a cut, or a
+    /// restored state with other cuts), so that the next step allocates nothing.
+    pub(crate) fn fit_boundaries(&mut self, bodies: &[Body]) {
+        self.workspace
+            .fit_boundaries(bodies.iter().map(|b| &*b.model));
+    }
+
+    /// Advance `scene` by `settings.dt` (see the module documentation). When a body becomes
+    /// non-finite or leaves the physical bounds of
+    /// [`Settings::divergence`](crate::Settings::divergence) the scene is rolled back to the
+    /// start of the step and [`Error::Diverged`] says which body and why.
+    pub(crate) fn step(&mut self, scene: &mut Scene) -> Result<StepReport, Error> {
+        let (n, clamped) = scene.substeps_needed();
         let mut rollback = std::mem::take(&mut self.workspace.rollback);
-        self.state_into(&mut rollback);
+        scene.state_into(&mut rollback, &self.pool);
         // A jump is not swept: the tool is placed at its target for the whole step and the
         // tissue it lands in leaves it at `max_depenetration_speed`. A blade does not push; it
         // cuts along its whole path, however fast.
-        let jump = self.tool_jump_distance();
-        for slot in self.tools.iter_mut().flatten().filter(|s| !s.blade) {
+        let jump = scene.tool_jump_distance();
+        for slot in scene.tools.iter_mut().flatten().filter(|s| !s.blade) {
             let t = &mut slot.tool;
             if t.travel() > jump {
                 t.pose = t.target;
             }
         }
-        let h = self.settings.dt / n as Real;
-        for slot in self.tools.iter_mut().flatten() {
+        let h = scene.settings.dt / n as Real;
+        for slot in scene.tools.iter_mut().flatten() {
             slot.load.impulse = Vec3::zeros();
             slot.load.moment = Vec3::zeros();
             slot.load.penetration = 0.0;
         }
         for k in 1..=n {
-            self.substep(h, k, n);
+            self.substep(scene, h, k, n);
         }
-        let limits = self.settings.divergence;
-        let failure = (self.bodies.iter().zip(&rollback.bodies))
+        let limits = scene.settings.divergence;
+        let failure = (scene.bodies.iter().zip(&rollback.bodies))
             .zip(&self.workspace.bodies)
             .enumerate()
             .find_map(|(b, ((body, before), scratch))| {
@@ -115,20 +163,20 @@ impl World {
             });
         if let Some((b, why)) = failure {
             // The whole state at the start of the step back: particles, grasps, needle holds.
-            self.apply_state(&rollback);
+            scene.apply_state(&rollback);
+            self.fit_boundaries(&scene.bodies);
             self.workspace.rollback = rollback;
-            self.diverged_steps += 1;
             return Err(Error::Diverged(format!(
                 "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
                  restore a state, or reduce dt or the stiffness)",
-                self.time
+                scene.time
             )));
         }
-        for slot in self.tools.iter_mut().flatten() {
+        for slot in scene.tools.iter_mut().flatten() {
             slot.grasp.end_step(h, n);
         }
         let mut cut = CutReport::default();
-        for slot in self.tools.iter().flatten().filter(|s| s.blade) {
+        for slot in scene.tools.iter().flatten().filter(|s| s.blade) {
             let t = &slot.tool;
             let half = match t.description {
                 ToolShape::Capsule { half_height, .. }
@@ -143,7 +191,7 @@ impl World {
                 from: edge(&t.pose),
                 to: edge(&t.target),
             };
-            for body in &mut self.bodies {
+            for body in &mut scene.bodies {
                 let r = crate::cut::cut(body, &blade);
                 cut.pairs += r.pairs;
                 cut.tets += r.tets;
@@ -151,11 +199,10 @@ impl World {
             }
         }
         if cut.tets > 0 {
-            let models = self.bodies.iter().map(|b| &*b.model);
-            self.workspace.fit_boundaries(models);
+            self.fit_boundaries(&scene.bodies);
         }
-        let dt = self.settings.dt;
-        for slot in self.tools.iter_mut().flatten() {
+        let dt = scene.settings.dt;
+        for slot in scene.tools.iter_mut().flatten() {
             let (t, load) = (&mut slot.tool, &slot.load);
             let scale = -1.0 / (h * h * n as Real);
             t.wrench = Wrench {
@@ -167,12 +214,12 @@ impl World {
             t.linear_velocity = (t.target.position - t.pose.position) / dt;
             t.pose = t.target;
         }
-        for slot in self.tools.iter_mut().flatten() {
+        for slot in scene.tools.iter_mut().flatten() {
             if let Some(needle) = &mut slot.needle {
-                needle.end_step(&slot.tool, &self.bodies);
+                needle.end_step(&slot.tool, &scene.bodies);
             }
         }
-        self.time += dt;
+        scene.time += dt;
         self.workspace.rollback = rollback;
         Ok(StepReport {
             substeps: n,
@@ -182,18 +229,18 @@ impl World {
     }
 
     /// Substep `k` of `n` (1-based) of length `h` (s).
-    fn substep(&mut self, h: Real, k: u32, n: u32) {
-        let s = &self.settings;
+    fn substep(&mut self, scene: &mut Scene, h: Real, k: u32, n: u32) {
+        let s = &scene.settings;
         let gravity = s.gravity;
         let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
         let scratch = &mut self.workspace.bodies;
-        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter_mut()) {
+        for (body, scratch) in scene.bodies.iter_mut().zip(scratch.iter_mut()) {
             predict::predict(body, scratch, gravity, h, alpha_damp, &self.pool);
         }
-        let organ_contact = self.bodies.len() > 1;
+        let organ_contact = scene.bodies.len() > 1;
         if organ_contact {
             let cell = 2.0
-                * self
+                * scene
                     .bodies
                     .iter()
                     .map(|b| b.model.particle_radius)
@@ -202,28 +249,28 @@ impl World {
                 .grid
                 .build(scratch.iter().map(|s| s.p.as_slice()), cell);
         }
-        for slot in self.tools.iter_mut().flatten() {
+        for slot in scene.tools.iter_mut().flatten() {
             slot.load.contacts = 0;
         }
-        for slot in self.tools.iter_mut().flatten() {
+        for slot in scene.tools.iter_mut().flatten() {
             slot.grasp.begin_substep();
         }
         let s_cur = k as Real / n as Real;
-        for slot in self.tools.iter_mut().flatten() {
+        for slot in scene.tools.iter_mut().flatten() {
             if let Some(needle) = &mut slot.needle {
                 let tool = &slot.tool;
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                 let mut views = Views {
-                    bodies: &self.bodies,
+                    bodies: &scene.bodies,
                     scratch,
                 };
                 needle.begin_substep(&mut views, &cur);
             }
         }
         let s_prev = (k - 1) as Real / n as Real;
-        for it in 0..self.settings.iterations {
-            if self.settings.volume_constraints {
-                for (body, scratch) in self.bodies.iter().zip(scratch.iter_mut()) {
+        for it in 0..scene.settings.iterations {
+            if scene.settings.volume_constraints {
+                for (body, scratch) in scene.bodies.iter().zip(scratch.iter_mut()) {
                     match body.volume_scheme {
                         VolumeScheme::Tetrahedra => {
                             volume::project_volumes(body, scratch, h, &self.pool)
@@ -237,28 +284,29 @@ impl World {
             if organ_contact {
                 organ_contact::project_organ_contacts(
                     &self.workspace.grid,
-                    &self.bodies,
+                    &scene.bodies,
                     scratch,
-                    &self.pair_friction,
+                    &scene.pair_friction,
                 );
             }
-            if self.settings.self_contact {
-                for (b, (body, scratch)) in self.bodies.iter().zip(scratch.iter_mut()).enumerate() {
+            if scene.settings.self_contact {
+                for (b, (body, scratch)) in scene.bodies.iter().zip(scratch.iter_mut()).enumerate()
+                {
                     let own = (b as u32, b as u32);
-                    let friction = (self.pair_friction.iter().find(|f| f.bodies == own))
+                    let friction = (scene.pair_friction.iter().find(|f| f.bodies == own))
                         .map_or((0.0, 0.0), |f| (f.mu_s, f.mu_k));
                     surface_self_contact::project_self_contacts(
                         &mut self.workspace.self_contact,
                         body,
                         scratch,
                         friction,
-                        self.settings.max_depenetration_speed * h,
+                        scene.settings.max_depenetration_speed * h,
                     );
                 }
             }
-            let mode = self.settings.contact_mode;
-            let max_correction = self.settings.max_depenetration_speed * h;
-            for slot in self.tools.iter_mut().flatten().filter(|s| !s.blade) {
+            let mode = scene.settings.contact_mode;
+            let max_correction = scene.settings.max_depenetration_speed * h;
+            for slot in scene.tools.iter_mut().flatten().filter(|s| !s.blade) {
                 let ToolSlot {
                     tool,
                     load,
@@ -268,7 +316,8 @@ impl World {
                 } = slot;
                 let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
                 let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                for (b, (body, scratch)) in self.bodies.iter().zip(scratch.iter_mut()).enumerate() {
+                for (b, (body, scratch)) in scene.bodies.iter().zip(scratch.iter_mut()).enumerate()
+                {
                     if needle.as_ref().is_some_and(|n| n.passes_through(b)) || grasp.holds(b) {
                         continue;
                     }
@@ -296,23 +345,23 @@ impl World {
                     }
                 }
             }
-            for slot in self.tools.iter_mut().flatten() {
+            for slot in scene.tools.iter_mut().flatten() {
                 if !slot.grasp.attachments.is_empty() {
                     let tool = &slot.tool;
                     let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                     let mut views = Views {
-                        bodies: &self.bodies,
+                        bodies: &scene.bodies,
                         scratch,
                     };
                     slot.grasp.project(&mut views, &cur, &mut slot.load, h);
                 }
             }
-            for slot in self.tools.iter_mut().flatten() {
+            for slot in scene.tools.iter_mut().flatten() {
                 if let Some(needle) = &mut slot.needle {
                     let tool = &slot.tool;
                     let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
                     let mut views = Views {
-                        bodies: &self.bodies,
+                        bodies: &scene.bodies,
                         scratch,
                     };
                     needle.project(&mut views, &cur, &mut slot.load, h);
@@ -323,9 +372,9 @@ impl World {
         // one scan per share merged in share order.
         let inv_h = 1.0 / h;
         let last = k == n;
-        for (body, scratch) in self.bodies.iter_mut().zip(scratch.iter_mut()) {
+        for (body, scratch) in scene.bodies.iter_mut().zip(scratch.iter_mut()) {
             let n = body.state.x.len();
-            let max_speed = crate::divergence::max_speed(body, &self.settings.divergence);
+            let max_speed = crate::divergence::max_speed(body, &scene.settings.divergence);
             let predicted = &scratch.p;
             let state = &mut body.state;
             let (position, velocity) = (

@@ -7,8 +7,8 @@ use crate::collision::hash_grid::HashGrid;
 use crate::constraints::contact::project_particle_particle;
 use crate::constraints::friction::friction_correction;
 use crate::math::{Real, Vec3};
+use crate::scene::PairFriction;
 use crate::solver::StepScratch;
-use crate::world::PairFriction;
 
 /// Bodies up to which the organ contact pass skips particles far from every other body (a
 /// fixed-size array: the step allocates nothing).

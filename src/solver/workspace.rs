@@ -1,6 +1,6 @@
-//! The step's workspace: all the memory a step uses and throws away, owned by the world apart
-//! from the bodies (model and state), sized when bodies are added and reused, so that a step
-//! allocates nothing.
+//! The step's workspace: all the memory a step uses and throws away, owned by the
+//! [`Pipeline`](super::Pipeline) apart from the scene (bodies' model and state, tools), sized
+//! when bodies are added and reused, so that a step allocates nothing.
 
 use crate::body::Body;
 use crate::body_model::BodyModel;
@@ -8,8 +8,8 @@ use crate::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
 use crate::math::{Real, Vec3};
 use crate::particles::ParticleView;
+use crate::scene::WorldState;
 use crate::solver::{SelfContactScratch, SurfaceScratch};
-use crate::world_state::WorldState;
 
 /// A body's working memory of a step; nothing in it outlives a substep.
 #[derive(Debug, Clone, PartialEq)]
@@ -98,7 +98,7 @@ impl StepScratch {
     }
 }
 
-/// Everything a step writes that is not the world's state.
+/// Everything a step writes that is not the scene's state.
 #[derive(Debug, Default)]
 pub(crate) struct Workspace {
     /// One per body, in body order.

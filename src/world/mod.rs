@@ -1,100 +1,40 @@
-//! The scene: bodies, tools, render surfaces and settings, and the API that builds and queries
-//! it. [`World::step`], Algorithm 1 of the paper, lives in the `solver` module, one pass a file.
+//! The public API of a simulation: [`World`], a scene (bodies, tools, settings, time) and the
+//! pipeline that steps it, with the render surfaces bound to its bodies. It builds and queries
+//! the scene, and steps it ([`World::step`]: `solver::Pipeline::step`, Algorithm 1 of the paper,
+//! one pass a file in the `solver` module). Its dynamic state as a value is in [`state`], as
+//! bytes in [`saved_state`].
+
+mod saved_state;
+mod state;
 
 use crate::body::{Body, BodyOptions};
 use crate::body_model::BodyModel;
-use crate::collision::tool::{check_friction, Pose, Tool, ToolLoad, ToolOptions, ToolShape};
+use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::needle::{Needle, NeedleOptions, NeedleState};
-use crate::parallel::Pool;
 use crate::render::{RenderMesh, RenderSurface};
+use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
 use crate::settings::Settings;
+use crate::solver::Pipeline;
 use std::sync::Arc;
-
-/// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
-/// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along
-/// and compressed tissue springs back (measured in `tests/api_robustness.rs`, friction 1,
-/// random sweeps at up to 12 m/s inside the default organ: tissue at up to 42 m/s, 3.5×), so
-/// the tool must stay well below the bound for the tissue to stay within it.
-pub const TOOL_JUMP_FRACTION: Real = 0.25;
-
-/// Identifies a body inside its world (index in insertion order, never reused).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct BodyId(pub u32);
-
-/// Identifies a tool inside its world (index in insertion order, never reused).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct ToolId(pub u32);
 
 /// Identifies a render surface inside its world (index in insertion order, never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct RenderSurfaceId(pub u32);
 
-/// What one step did.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct StepReport {
-    /// Substeps taken.
-    pub substeps: u32,
-    /// True when stability asked for more than `Settings::max_substeps` substeps.
-    pub substeps_clamped: bool,
-    /// What the blades cut at the end of this step (all bodies together).
-    pub cut: CutReport,
-}
-
-/// Friction between two bodies.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PairFriction {
-    pub(crate) bodies: (u32, u32),
-    pub(crate) mu_s: Real,
-    pub(crate) mu_k: Real,
-}
-
-/// One tool of a world: its shape and pose, what the interactions put on it during a step, and
-/// the roles it plays (a tool may grasp, be a needle and be a blade at once).
-#[derive(Debug)]
-pub(crate) struct ToolSlot {
-    /// Shape, pose, target pose, options, last wrench.
-    pub(crate) tool: Tool,
-    /// What contact, grasp and needle put on the tool in the step in progress.
-    pub(crate) load: ToolLoad,
-    /// The tool's grasp (no attachments: not grasping).
-    pub(crate) grasp: Grasp,
-    /// The tool's needle (`None`: not a needle).
-    pub(crate) needle: Option<Needle>,
-    /// Whether the tool is a blade.
-    pub(crate) blade: bool,
-}
-
-impl ToolSlot {
-    /// A tool that is neither grasping, a needle nor a blade.
-    fn new(tool: Tool) -> ToolSlot {
-        ToolSlot {
-            tool,
-            load: ToolLoad::default(),
-            grasp: Grasp::default(),
-            needle: None,
-            blade: false,
-        }
-    }
-}
-
-/// A simulated scene.
+/// A simulated scene: the scene's bodies, tools and settings, the pipeline that steps them and
+/// the render surfaces bound to the bodies.
 pub struct World {
-    pub(crate) settings: Settings,
-    pub(crate) bodies: Vec<Body>,
-    /// The tools, one slot each, by id ([`ToolId`] is the index); `None` for a removed tool
-    /// (ids are never reused).
-    pub(crate) tools: Vec<Option<ToolSlot>>,
+    /// What a step advances: settings, bodies, tools, body-pair friction, time.
+    pub(crate) scene: Scene,
+    /// The step's scratch memory (the rollback copy included) and threads.
+    pub(crate) pipeline: Pipeline,
     pub(crate) render_surfaces: Vec<RenderSurface>,
-    pub(crate) pair_friction: Vec<PairFriction>,
-    /// All the memory a step uses and throws away.
-    pub(crate) workspace: crate::solver::Workspace,
-    pub(crate) pool: Pool,
-    pub(crate) time: Real,
+    /// Steps that diverged and were rolled back.
     pub(crate) diverged_steps: u64,
 }
 
@@ -103,25 +43,20 @@ impl World {
     pub fn new(settings: Settings) -> Result<Self, Error> {
         settings.validate()?;
         Ok(World {
-            pool: Pool::new(settings.threads as usize),
-            settings,
-            bodies: Vec::new(),
-            tools: Vec::new(),
+            pipeline: Pipeline::new(settings.threads),
+            scene: Scene::new(settings),
             render_surfaces: Vec::new(),
-            pair_friction: Vec::new(),
-            workspace: Default::default(),
-            time: 0.0,
             diverged_steps: 0,
         })
     }
     /// The settings in force.
     pub fn settings(&self) -> &Settings {
-        &self.settings
+        &self.scene.settings
     }
     /// Replace the settings (validated; the world is unchanged on error).
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), Error> {
         settings.validate()?;
-        let s = &self.settings;
+        let s = &self.scene.settings;
         let bodies_affected = settings.hourglass_stiffness != s.hourglass_stiffness
             || settings.volume_constraints != s.volume_constraints
             || settings.volumetric_split != s.volumetric_split
@@ -134,21 +69,20 @@ impl World {
             || settings.min_substeps != s.min_substeps
             || settings.stability_margin != s.stability_margin;
         if bodies_affected {
-            for b in &mut self.bodies {
+            for b in &mut self.scene.bodies {
                 b.configure(&settings);
             }
         }
         if settings.threads != s.threads {
-            self.pool = Pool::new(settings.threads as usize);
-            let models = self.bodies.iter().map(|b| &*b.model);
-            self.workspace.set_threads(models, self.pool.threads());
+            self.pipeline
+                .set_threads(settings.threads, &self.scene.bodies);
         }
-        self.settings = settings;
+        self.scene.settings = settings;
         Ok(())
     }
     /// Simulated time (s) since the world was created.
     pub fn time(&self) -> Real {
-        self.time
+        self.scene.time
     }
     /// Number of steps that produced NaN/Inf and were rolled back.
     pub fn diverged_steps(&self) -> u64 {
@@ -164,24 +98,18 @@ impl World {
     /// and its arrays are not copied. Cutting the body gives it its own copy of the model
     /// first; the other holders keep theirs.
     pub fn add_body_model(&mut self, model: Arc<BodyModel>) -> BodyId {
-        self.workspace.add_body(&model, self.pool.threads());
-        self.bodies.push(Body::from_model(model, &self.settings));
-        BodyId(self.bodies.len() as u32 - 1)
+        self.pipeline.add_body(&model);
+        let scene = &mut self.scene;
+        scene.bodies.push(Body::from_model(model, &scene.settings));
+        BodyId(scene.bodies.len() as u32 - 1)
     }
     /// Number of bodies.
     pub fn body_count(&self) -> usize {
-        self.bodies.len()
+        self.scene.bodies.len()
     }
     /// A body by id.
     pub fn body(&self, id: BodyId) -> Result<&Body, Error> {
-        self.bodies
-            .get(id.0 as usize)
-            .ok_or(Error::UnknownBody(id.0))
-    }
-    fn body_mut(&mut self, id: BodyId) -> Result<&mut Body, Error> {
-        self.bodies
-            .get_mut(id.0 as usize)
-            .ok_or(Error::UnknownBody(id.0))
+        self.scene.body(id)
     }
     /// Set the positions (m) and velocities (m/s) of every particle of a body, e.g. an initial
     /// condition. Both slices must have one entry per particle, in particle order
@@ -196,7 +124,7 @@ impl World {
         positions: &[Vec3],
         velocities: &[Vec3],
     ) -> Result<(), Error> {
-        let body = self.body_mut(id)?;
+        let body = self.scene.body_mut(id)?;
         let n = body.particle_count();
         if positions.len() != n || velocities.len() != n {
             return Err(Error::InvalidArgument(format!(
@@ -253,7 +181,7 @@ impl World {
             .render_surfaces
             .get_mut(id.0 as usize)
             .ok_or(Error::UnknownRenderSurface(id.0))?;
-        let body = &self.bodies[surface.body().0 as usize];
+        let body = &self.scene.bodies[surface.body().0 as usize];
         surface.update(body.positions());
         Ok(surface)
     }
@@ -262,7 +190,7 @@ impl World {
     /// indices). They keep their current position. Nothing is fixed if any index is out of
     /// range.
     pub fn fix_particles(&mut self, id: BodyId, indices: &[u32]) -> Result<(), Error> {
-        let body = self.body_mut(id)?;
+        let body = self.scene.body_mut(id)?;
         let n = body.particle_count();
         if let Some(&k) = indices.iter().find(|&&k| k as usize >= n) {
             return Err(Error::InvalidArgument(format!(
@@ -284,7 +212,7 @@ impl World {
                 "fixed box: min must be <= max on every axis".into(),
             ));
         }
-        let body = self.body_mut(id)?;
+        let body = self.scene.body_mut(id)?;
         let inside: Vec<usize> = (0..body.particle_count())
             .filter(|&i| {
                 let p = body.state.x[i];
@@ -302,23 +230,21 @@ impl World {
         pose: Pose,
         options: &ToolOptions,
     ) -> Result<ToolId, Error> {
-        let spacing = self
-            .bodies
-            .first()
+        let spacing = (self.scene.bodies.first())
             .map(|b| b.particle_radius())
             .unwrap_or(0.005);
-        let id = u32::try_from(self.tools.len())
+        let id = u32::try_from(self.scene.tools.len())
             .map_err(|_| Error::InvalidArgument("no tool id left".into()))?;
         let tool = Tool::new(shape, pose, options, spacing)?;
-        self.tools.push(Some(ToolSlot::new(tool)));
+        self.scene.tools.push(Some(ToolSlot::new(tool)));
         Ok(ToolId(id))
     }
     /// Remove a tool: it no longer touches the tissue from the next step on, and its id stays
     /// unused (later tools get new ids; calls with the removed id give
     /// [`Error::UnknownTool`]). Nothing changes on error.
     pub fn remove_tool(&mut self, id: ToolId) -> Result<(), Error> {
-        self.slot(id)?;
-        self.tools[id.0 as usize] = None;
+        self.scene.slot(id)?;
+        self.scene.tools[id.0 as usize] = None;
         Ok(())
     }
     /// Cut body `id` with `blade` now (see [`crate::cut`]): the neighbour pairs and tetrahedra
@@ -328,10 +254,8 @@ impl World {
         if ends.clone().any(|p| !is_finite_vec(p)) {
             return Err(Error::NonFinite("blade edge".into()));
         }
-        self.body(id)?;
-        let report = crate::cut::cut(&mut self.bodies[id.0 as usize], blade);
-        let models = self.bodies.iter().map(|b| &*b.model);
-        self.workspace.fit_boundaries(models);
+        let report = crate::cut::cut(self.scene.body_mut(id)?, blade);
+        self.pipeline.fit_boundaries(&self.scene.bodies);
         Ok(report)
     }
     /// Make tool `id` (a capsule or a cylinder) a blade: its edge is the segment of its local y
@@ -339,7 +263,7 @@ impl World {
     /// its edge swept during the step, and it does not push the tissue (a blade slices). Nothing
     /// changes on error.
     pub fn make_blade(&mut self, id: ToolId) -> Result<(), Error> {
-        let slot = self.slot_mut(id)?;
+        let slot = self.scene.slot_mut(id)?;
         match slot.tool.description {
             ToolShape::Capsule { .. } | ToolShape::Cylinder { .. } => {
                 slot.blade = true;
@@ -355,14 +279,14 @@ impl World {
     /// force, then holds the tissue on its shaft with axial friction (see [`crate::needle`]).
     /// Nothing changes on error.
     pub fn make_needle(&mut self, id: ToolId, options: &NeedleOptions) -> Result<(), Error> {
-        let slot = self.slot_mut(id)?;
+        let slot = self.scene.slot_mut(id)?;
         slot.needle = Some(Needle::new(&slot.tool, *options)?);
         Ok(())
     }
     /// The insertion state of needle `id` ([`Error::InvalidArgument`] if the tool is not a
     /// needle).
     pub fn needle_state(&self, id: ToolId) -> Result<NeedleState, Error> {
-        let slot = self.slot(id)?;
+        let slot = self.scene.slot(id)?;
         let needle = (slot.needle.as_ref())
             .ok_or_else(|| Error::InvalidArgument(format!("tool {} is not a needle", id.0)))?;
         Ok(NeedleState {
@@ -378,51 +302,37 @@ impl World {
     /// one. Returns the number of grasped particles (0: nothing within reach, not an error).
     /// Nothing changes on error.
     pub fn grasp(&mut self, id: ToolId, options: &GraspOptions) -> Result<usize, Error> {
-        let grasp = Grasp::new(&self.slot(id)?.tool, &self.bodies, options)?;
+        let scene = &mut self.scene;
+        let grasp = Grasp::new(&scene.slot(id)?.tool, &scene.bodies, options)?;
         let count = grasp.attachments.len();
-        self.slot_mut(id)?.grasp = grasp;
+        scene.slot_mut(id)?.grasp = grasp;
         Ok(count)
     }
     /// Release tool `id`'s grasp: the tissue is free again (contact with the tool still acts).
     pub fn release(&mut self, id: ToolId) -> Result<(), Error> {
-        self.slot_mut(id)?.grasp = Grasp::default();
+        self.scene.slot_mut(id)?.grasp = Grasp::default();
         Ok(())
     }
     /// Number of particles tool `id` holds (0 when not grasping, or after the tissue slipped).
     pub fn grasped_count(&self, id: ToolId) -> Result<usize, Error> {
-        Ok(self.slot(id)?.grasp.attachments.len())
+        Ok(self.scene.slot(id)?.grasp.attachments.len())
     }
     /// Number of tools in the world (removed tools not counted).
     pub fn tool_count(&self) -> usize {
-        self.tools.iter().flatten().count()
+        self.scene.tool_count()
     }
     /// The ids of the tools in the world, in increasing order (removed tools left out).
     pub fn tool_ids(&self) -> impl Iterator<Item = ToolId> + '_ {
-        self.tools
-            .iter()
-            .enumerate()
+        (self.scene.tools.iter().enumerate())
             .filter(|(_, t)| t.is_some())
             .map(|(i, _)| ToolId(i as u32))
     }
     /// A tool by id ([`Error::UnknownTool`] for an id never issued or removed).
     pub fn tool(&self, id: ToolId) -> Result<&Tool, Error> {
-        Ok(&self.slot(id)?.tool)
+        Ok(&self.scene.slot(id)?.tool)
     }
     fn tool_mut(&mut self, id: ToolId) -> Result<&mut Tool, Error> {
-        Ok(&mut self.slot_mut(id)?.tool)
-    }
-    /// A tool's slot by id ([`Error::UnknownTool`] for an id never issued or removed).
-    fn slot(&self, id: ToolId) -> Result<&ToolSlot, Error> {
-        self.tools
-            .get(id.0 as usize)
-            .and_then(Option::as_ref)
-            .ok_or(Error::UnknownTool(id.0))
-    }
-    fn slot_mut(&mut self, id: ToolId) -> Result<&mut ToolSlot, Error> {
-        self.tools
-            .get_mut(id.0 as usize)
-            .and_then(Option::as_mut)
-            .ok_or(Error::UnknownTool(id.0))
+        Ok(&mut self.scene.slot_mut(id)?.tool)
     }
     /// Set the pose a tool reaches at the end of the next step (interpolated across substeps).
     /// A NaN/Inf or non-unit pose is rejected and nothing changes.
@@ -463,8 +373,9 @@ impl World {
         self.body(b)?;
         check_friction(friction_static, friction_kinetic)?;
         let key = (a.0.min(b.0), a.0.max(b.0));
-        self.pair_friction.retain(|f| f.bodies != key);
-        self.pair_friction.push(PairFriction {
+        let pairs = &mut self.scene.pair_friction;
+        pairs.retain(|f| f.bodies != key);
+        pairs.push(PairFriction {
             bodies: key,
             mu_s: friction_static,
             mu_k: friction_kinetic,
@@ -473,25 +384,15 @@ impl World {
     }
 
     /// The fastest (m/s) a tool may move and still be swept across the substeps, pushing the
-    /// tissue along: [`TOOL_JUMP_FRACTION`] of the divergence bound on particle speed
-    /// (`divergence.max_speed` body sizes per second, the smallest over the bodies). A faster
-    /// pose change is a jump (a tracking glitch): the tissue it would push along could move
-    /// faster than the bound and fail the step, so [`World::step`] places the tool at its new
-    /// pose at once, and the tissue it lands in leaves it at
+    /// tissue along: [`TOOL_JUMP_FRACTION`](crate::TOOL_JUMP_FRACTION) of the divergence bound
+    /// on particle speed (`divergence.max_speed` body sizes per second, the smallest over the
+    /// bodies). A faster pose change is a jump (a tracking glitch): the tissue it would push
+    /// along could move faster than the bound and fail the step, so [`World::step`] places the
+    /// tool at its new pose at once, and the tissue it lands in leaves it at
     /// [`Settings::max_depenetration_speed`]. Infinite when the speed bound is off or the world
     /// has no body.
     pub fn tool_jump_speed(&self) -> Real {
-        let bound = self.settings.divergence.max_speed;
-        let slowest = (self.bodies.iter())
-            .map(|b| bound * b.model.size)
-            .fold(Real::INFINITY, Real::min);
-        TOOL_JUMP_FRACTION * slowest
-    }
-
-    /// The distance (m) beyond which a tool's pose change in one step is a jump:
-    /// [`World::tool_jump_speed`] times `dt`.
-    pub(crate) fn tool_jump_distance(&self) -> Real {
-        self.tool_jump_speed() * self.settings.dt
+        self.scene.tool_jump_speed()
     }
 
     /// Substeps the next step needs, and whether `max_substeps` clamped that number: enough
@@ -500,34 +401,19 @@ impl World {
     /// substep, so that a fast tool is swept rather than teleported; a jump (faster than
     /// [`World::tool_jump_speed`]) is not swept.
     pub fn substeps_needed(&self) -> (u32, bool) {
-        let s = &self.settings;
-        let mut h_max = Real::INFINITY;
-        let mut radius = Real::INFINITY;
-        for b in &self.bodies {
-            let w = b.omega_max;
-            if w > 0.0 {
-                // Symplectic Euler with stiffness-proportional damping ξ = βω/2.
-                let xi = 0.5 * s.damping_stiffness * w;
-                h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
-            }
-            radius = radius.min(b.model.particle_radius);
+        self.scene.substeps_needed()
+    }
+
+    /// Advance the world by `settings.dt` (`solver::Pipeline::step` on the world's scene).
+    /// When a body becomes non-finite or leaves the physical bounds of
+    /// [`Settings::divergence`](crate::Settings::divergence) the world is rolled back to the
+    /// start of the step and [`Error::Diverged`] says which body and why.
+    pub fn step(&mut self) -> Result<StepReport, Error> {
+        let report = self.pipeline.step(&mut self.scene);
+        if let Err(Error::Diverged(_)) = report {
+            self.diverged_steps += 1;
         }
-        let stable = (s.dt / (s.stability_margin * h_max)).ceil();
-        let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
-        let jump = self.tool_jump_distance();
-        let tools = self.tools.iter().flatten().map(|s| &s.tool);
-        for t in tools.filter(|t| t.travel() <= jump) {
-            let sweep = (t.travel() / radius).ceil();
-            if sweep.is_finite() {
-                needed = needed.max(sweep.min(u32::MAX as Real) as u32);
-            }
-        }
-        let n = needed.max(s.min_substeps);
-        if n > s.max_substeps {
-            (s.max_substeps, true)
-        } else {
-            (n, false)
-        }
+        report
     }
 
     /// Bring the world to rest in its equilibrium under gravity, fixed particles held: a scene
@@ -555,25 +441,25 @@ impl World {
     /// [`SETTLE_MAX_STEPS`]: crate::statics::SETTLE_MAX_STEPS
     pub fn settle(&mut self) -> Result<crate::statics::SettleReport, Error> {
         use crate::statics::{settle_body, SettleReport, SETTLE_MAX_STEPS, SETTLE_SPEED};
-        let g = self.settings.gravity;
-        let mut settled = self.bodies.clone();
+        let g = self.scene.settings.gravity;
+        let mut settled = self.scene.bodies.clone();
         let (mut newton_iterations, mut relative_residual) = (0, 0.0 as Real);
         for body in &mut settled {
             let s = settle_body(body, g)?;
             newton_iterations += s.iterations;
             relative_residual = relative_residual.max(s.relative_residual);
         }
-        let before = std::mem::replace(&mut self.bodies, settled);
-        let time = self.time;
+        let before = std::mem::replace(&mut self.scene.bodies, settled);
+        let time = self.scene.time;
         let (steps, speed) = match self.relax(SETTLE_MAX_STEPS, true) {
             Ok(r) => r,
             Err(e) => {
-                self.bodies = before;
-                self.time = time;
+                self.scene.bodies = before;
+                self.scene.time = time;
                 return Err(e);
             }
         };
-        self.time = time;
+        self.scene.time = time;
         Ok(SettleReport {
             newton_iterations,
             relative_residual,
@@ -597,7 +483,7 @@ impl World {
     fn relax(&mut self, max_steps: u32, back: bool) -> Result<(u32, Real), Error> {
         // Stop every particle after moving it back by its velocity times `rewind` (s).
         let at_rest = |w: &mut World, rewind: Real| {
-            for b in &mut w.bodies {
+            for b in &mut w.scene.bodies {
                 let state = &mut b.state;
                 for (x, v) in state.x.iter_mut().zip(state.v.iter_mut()) {
                     *x -= *v * rewind;
@@ -611,19 +497,22 @@ impl World {
         while steps < max_steps {
             let report = self.step()?;
             steps += 1;
-            speed = (self.bodies.iter().flat_map(|b| b.state.v.iter()))
+            speed = (self.scene.bodies.iter().flat_map(|b| b.state.v.iter()))
                 .map(|v| v.norm())
                 .fold(0.0, Real::max);
             if speed < crate::statics::SETTLE_SPEED {
                 break;
             }
-            let kinetic: Real = (self.bodies.iter())
+            let kinetic: Real = (self.scene.bodies.iter())
                 .flat_map(|b| b.state.v.iter().zip(&b.inertial_mass))
                 .map(|(v, m)| m * v.norm_squared())
                 .sum();
             if kinetic < previous {
                 let half = if back { 0.5 } else { 0.0 };
-                at_rest(self, half * self.settings.dt / report.substeps as Real);
+                at_rest(
+                    self,
+                    half * self.scene.settings.dt / report.substeps as Real,
+                );
                 previous = 0.0;
             } else {
                 previous = kinetic;
@@ -662,10 +551,10 @@ mod tests {
         world
             .fix_box(id, Vec3::repeat(-1.0), Vec3::new(1.0, 1e-6, 1.0))
             .unwrap();
-        let omega = world.bodies[0].max_angular_frequency();
+        let omega = world.scene.bodies[0].max_angular_frequency();
         world.set_settings(settings(1.97 / omega)).unwrap();
         assert_eq!(world.substeps_needed().0, 1);
-        let body = &world.bodies[0];
+        let body = &world.scene.bodies[0];
         let x: Vec<Vec3> = (body.rest_positions().iter().enumerate())
             .map(|(i, x)| {
                 let (a, b, c) = (i % 7, (i / 7) % 7, i / 49);
@@ -718,11 +607,11 @@ mod tests {
             w
         };
         let kept = |w: &World| {
-            let s = &w.workspace.bodies[0];
+            let s = &w.pipeline.workspace.bodies[0];
             (s.pair_force.len(), s.own_force.len())
         };
         let sized = {
-            let b = &world(1).bodies[0];
+            let b = &world(1).scene.bodies[0];
             (b.model.nbr.slot_count(), b.state.x.len())
         };
         let mut switched = world(1);
@@ -740,8 +629,15 @@ mod tests {
             switched.step().unwrap();
             built.step().unwrap();
         }
-        assert_eq!(switched.bodies[0].state.x, built.bodies[0].state.x);
-        assert!(switched.bodies[0].state.v.iter().any(|v| v.norm() > 0.0));
+        assert_eq!(
+            switched.scene.bodies[0].state.x,
+            built.scene.bodies[0].state.x
+        );
+        assert!(switched.scene.bodies[0]
+            .state
+            .v
+            .iter()
+            .any(|v| v.norm() > 0.0));
         switched.set_settings(Settings::default()).unwrap();
         assert_eq!(kept(&switched), (0, 0));
         switched.step().unwrap();

@@ -1,11 +1,17 @@
-//! The dynamic state of a world as one value, [`WorldState`]: what a step advances, what a
+//! The scene's dynamic state as one value, [`WorldState`]: what a step advances, what a
 //! diverged step's rollback puts back, and what [`World::save_state`] and
 //! [`World::restore_state`] write and read (through the byte format of [`crate::state`]).
 //!
-//! One mechanism serves the three: [`World::state_into`] copies the world's state into a value
-//! (reusing its memory, so the step's rollback copy allocates nothing), [`World::set_state`]
-//! checks a value against the world and applies it, and the step puts its rollback copy back
-//! with the same code, unchecked.
+//! One mechanism serves the three: [`Scene::state_into`] copies the scene's state into a value
+//! (reusing its memory, so the step's rollback copy allocates nothing), [`Scene::set_state`]
+//! checks a value against the scene and applies it, and the step puts its rollback copy back
+//! with the same code, unchecked ([`Scene::apply_state`]). [`World::state_into`] and
+//! [`World::set_state`] are these, on the world's scene.
+//!
+//! [`World::save_state`]: crate::World::save_state
+//! [`World::restore_state`]: crate::World::restore_state
+//! [`World::state_into`]: crate::World::state_into
+//! [`World::set_state`]: crate::World::set_state
 
 use crate::body::{Body, ParticleState};
 use crate::collision::tool::{Pose, Wrench};
@@ -14,7 +20,8 @@ use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::math::{is_finite_vec, Real, Vec3};
 use crate::needle::ShaftHold;
-use crate::world::World;
+use crate::parallel::Pool;
+use crate::scene::Scene;
 use std::sync::Arc;
 
 /// The dynamic state of a world: the time; per body its particles' positions, velocities and
@@ -22,7 +29,8 @@ use std::sync::Arc;
 /// last wrench, grasp and needle insertion.
 ///
 /// The scene (meshes, materials, tool shapes, settings) is not part of it: a state applies to
-/// the world it was taken from or to one built the same way ([`World::set_state`] checks).
+/// the world it was taken from or to one built the same way
+/// ([`World::set_state`](crate::World::set_state) checks).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct WorldState {
     /// Simulated time (s).
@@ -97,23 +105,16 @@ impl BodyState {
     }
 }
 
-impl World {
-    /// The world's dynamic state as a value (see [`WorldState`]).
-    pub fn state(&self) -> WorldState {
-        let mut out = WorldState::default();
-        self.state_into(&mut out);
-        out
-    }
-
-    /// Copy the world's dynamic state into `out`, reusing its memory: once `out` has held a
-    /// state of this world, this allocates nothing.
-    pub fn state_into(&self, out: &mut WorldState) {
+impl Scene {
+    /// Copy the scene's dynamic state into `out`, reusing its memory (the particles copied on
+    /// `pool`'s threads): once `out` has held a state of this scene, this allocates nothing.
+    pub(crate) fn state_into(&self, out: &mut WorldState, pool: &Pool) {
         out.time = self.time;
         out.bodies.truncate(self.bodies.len());
         for (k, body) in self.bodies.iter().enumerate() {
             match out.bodies.get_mut(k) {
                 Some(s) => {
-                    s.particles.assign_on(&body.state, &self.pool);
+                    s.particles.assign_on(&body.state, pool);
                     s.fixed.clone_from(&body.fixed);
                     s.cuts = crate::cut::cut_sets(body);
                 }
@@ -164,19 +165,17 @@ impl World {
         out.tools.truncate(k);
     }
 
-    /// Put the world in `state`, taken from this world or from one built the same way. On any
-    /// mismatch (body, tool or particle counts, non-finite values, a particle farther than
-    /// [`STATE_POSITION_LIMIT`](crate::STATE_POSITION_LIMIT) body sizes from its body's rest
-    /// centre or faster than [`STATE_SPEED_LIMIT`](crate::STATE_SPEED_LIMIT) body sizes per
-    /// second, a grasp or needle hold of an unknown particle, a cut outside the body) the world
-    /// is left unchanged and [`Error::BadState`] says why.
-    pub fn set_state(&mut self, state: &WorldState) -> Result<(), Error> {
+    /// Put the scene in `state`, taken from this scene or from one built the same way; on any
+    /// mismatch the scene is left unchanged and [`Error::BadState`] says why (see
+    /// [`World::set_state`](crate::World::set_state)). A restored cut changes a boundary: the
+    /// pipeline's scratch is then refitted (`Pipeline::fit_boundaries`).
+    pub(crate) fn set_state(&mut self, state: &WorldState) -> Result<(), Error> {
         self.check_state(state).map_err(Error::BadState)?;
         self.apply_state(state);
         Ok(())
     }
 
-    /// Why `state` does not fit this world, if it does not.
+    /// Why `state` does not fit this scene, if it does not.
     fn check_state(&self, state: &WorldState) -> Result<(), String> {
         if !state.time.is_finite() {
             return Err("non-finite time".into());
@@ -244,9 +243,10 @@ impl World {
         Ok(())
     }
 
-    /// Put the world in `state`, which fits it (checked by [`World::set_state`], or taken from
-    /// it by [`World::state_into`]). Allocates nothing when only the particles, the tools and
-    /// the fixed flags differ.
+    /// Put the scene in `state`, which fits it (checked by [`Scene::set_state`], or taken from
+    /// it by [`Scene::state_into`]). Allocates nothing when only the particles, the tools and
+    /// the fixed flags differ. A restored cut changes a boundary: the caller refits the
+    /// pipeline's scratch (`Pipeline::fit_boundaries`) before the next step.
     pub(crate) fn apply_state(&mut self, state: &WorldState) {
         self.time = state.time;
         for (body, s) in self.bodies.iter_mut().zip(&state.bodies) {
@@ -257,8 +257,6 @@ impl World {
             }
             body.state.assign(&s.particles);
         }
-        let models = self.bodies.iter().map(|b| &*b.model);
-        self.workspace.fit_boundaries(models);
         for (slot, s) in self.tools.iter_mut().flatten().zip(&state.tools) {
             let (tool, grasp, needle) = (&mut slot.tool, &mut slot.grasp, &mut slot.needle);
             (tool.pose, tool.target, tool.linear_velocity, tool.wrench) =

@@ -1,0 +1,202 @@
+//! The scene: what a step advances. The settings, the bodies, one slot per tool, the body-pair
+//! friction and the simulated time, with the lookups by id and what the step needs to know of
+//! them before it starts (how many substeps, when a tool jumps).
+//!
+//! A [`Scene`] holds no scratch memory and no threads: `solver::Pipeline` owns those and steps
+//! the scene it is handed; [`World`](crate::World) is the public API over the two. The scene's
+//! dynamic state as one value, [`WorldState`], is in [`state`].
+
+pub(crate) mod state;
+
+pub use state::WorldState;
+
+use crate::body::Body;
+use crate::collision::tool::{Tool, ToolLoad};
+use crate::cut::CutReport;
+use crate::error::Error;
+use crate::grasp::Grasp;
+use crate::math::Real;
+use crate::needle::Needle;
+use crate::settings::Settings;
+
+/// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
+/// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along
+/// and compressed tissue springs back (measured in `tests/api_robustness.rs`, friction 1,
+/// random sweeps at up to 12 m/s inside the default organ: tissue at up to 42 m/s, 3.5×), so
+/// the tool must stay well below the bound for the tissue to stay within it.
+pub const TOOL_JUMP_FRACTION: Real = 0.25;
+
+/// Identifies a body inside its world (index in insertion order, never reused).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BodyId(pub u32);
+
+/// Identifies a tool inside its world (index in insertion order, never reused).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ToolId(pub u32);
+
+/// What one step did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepReport {
+    /// Substeps taken.
+    pub substeps: u32,
+    /// True when stability asked for more than `Settings::max_substeps` substeps.
+    pub substeps_clamped: bool,
+    /// What the blades cut at the end of this step (all bodies together).
+    pub cut: CutReport,
+}
+
+/// Friction between two bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PairFriction {
+    pub(crate) bodies: (u32, u32),
+    pub(crate) mu_s: Real,
+    pub(crate) mu_k: Real,
+}
+
+/// One tool of a scene: its shape and pose, what the interactions put on it during a step, and
+/// the roles it plays (a tool may grasp, be a needle and be a blade at once).
+#[derive(Debug)]
+pub(crate) struct ToolSlot {
+    /// Shape, pose, target pose, options, last wrench.
+    pub(crate) tool: Tool,
+    /// What contact, grasp and needle put on the tool in the step in progress.
+    pub(crate) load: ToolLoad,
+    /// The tool's grasp (no attachments: not grasping).
+    pub(crate) grasp: Grasp,
+    /// The tool's needle (`None`: not a needle).
+    pub(crate) needle: Option<Needle>,
+    /// Whether the tool is a blade.
+    pub(crate) blade: bool,
+}
+
+impl ToolSlot {
+    /// A tool that is neither grasping, a needle nor a blade.
+    pub(crate) fn new(tool: Tool) -> ToolSlot {
+        ToolSlot {
+            tool,
+            load: ToolLoad::default(),
+            grasp: Grasp::default(),
+            needle: None,
+            blade: false,
+        }
+    }
+}
+
+/// What a step advances: settings, bodies (model and state), tools, body-pair friction, time.
+pub(crate) struct Scene {
+    /// The settings in force (validated).
+    pub(crate) settings: Settings,
+    /// The bodies, by id ([`BodyId`] is the index).
+    pub(crate) bodies: Vec<Body>,
+    /// The tools, one slot each, by id ([`ToolId`] is the index); `None` for a removed tool
+    /// (ids are never reused).
+    pub(crate) tools: Vec<Option<ToolSlot>>,
+    /// Friction between pairs of bodies (frictionless for a pair without an entry).
+    pub(crate) pair_friction: Vec<PairFriction>,
+    /// Simulated time (s).
+    pub(crate) time: Real,
+}
+
+impl Scene {
+    /// An empty scene at time 0 under `settings` (validated by the caller).
+    pub(crate) fn new(settings: Settings) -> Scene {
+        Scene {
+            settings,
+            bodies: Vec::new(),
+            tools: Vec::new(),
+            pair_friction: Vec::new(),
+            time: 0.0,
+        }
+    }
+
+    /// A body by id.
+    pub(crate) fn body(&self, id: BodyId) -> Result<&Body, Error> {
+        self.bodies
+            .get(id.0 as usize)
+            .ok_or(Error::UnknownBody(id.0))
+    }
+
+    /// A body by id, to change.
+    pub(crate) fn body_mut(&mut self, id: BodyId) -> Result<&mut Body, Error> {
+        self.bodies
+            .get_mut(id.0 as usize)
+            .ok_or(Error::UnknownBody(id.0))
+    }
+
+    /// A tool's slot by id ([`Error::UnknownTool`] for an id never issued or removed).
+    pub(crate) fn slot(&self, id: ToolId) -> Result<&ToolSlot, Error> {
+        self.tools
+            .get(id.0 as usize)
+            .and_then(Option::as_ref)
+            .ok_or(Error::UnknownTool(id.0))
+    }
+
+    /// A tool's slot by id, to change ([`Error::UnknownTool`] for an id never issued or
+    /// removed).
+    pub(crate) fn slot_mut(&mut self, id: ToolId) -> Result<&mut ToolSlot, Error> {
+        self.tools
+            .get_mut(id.0 as usize)
+            .and_then(Option::as_mut)
+            .ok_or(Error::UnknownTool(id.0))
+    }
+
+    /// Number of tools (removed tools not counted).
+    pub(crate) fn tool_count(&self) -> usize {
+        self.tools.iter().flatten().count()
+    }
+
+    /// The fastest (m/s) a tool may move and still be swept across the substeps:
+    /// [`TOOL_JUMP_FRACTION`] of the divergence bound on particle speed
+    /// (`divergence.max_speed` body sizes per second, the smallest over the bodies); infinite
+    /// when the speed bound is off or the scene has no body. See
+    /// [`World::tool_jump_speed`](crate::World::tool_jump_speed).
+    pub(crate) fn tool_jump_speed(&self) -> Real {
+        let bound = self.settings.divergence.max_speed;
+        let slowest = (self.bodies.iter())
+            .map(|b| bound * b.model.size)
+            .fold(Real::INFINITY, Real::min);
+        TOOL_JUMP_FRACTION * slowest
+    }
+
+    /// The distance (m) beyond which a tool's pose change in one step is a jump:
+    /// [`Scene::tool_jump_speed`] times `dt`.
+    pub(crate) fn tool_jump_distance(&self) -> Real {
+        self.tool_jump_speed() * self.settings.dt
+    }
+
+    /// Substeps the next step needs, and whether `max_substeps` clamped that number: enough
+    /// for the explicit stability limit of the stiffest body, and enough that no tool moves
+    /// (translation plus rotation at its bounding radius) more than one particle radius per
+    /// substep, so that a fast tool is swept rather than teleported; a jump (faster than
+    /// [`Scene::tool_jump_speed`]) is not swept.
+    pub(crate) fn substeps_needed(&self) -> (u32, bool) {
+        let s = &self.settings;
+        let mut h_max = Real::INFINITY;
+        let mut radius = Real::INFINITY;
+        for b in &self.bodies {
+            let w = b.omega_max;
+            if w > 0.0 {
+                // Symplectic Euler with stiffness-proportional damping ξ = βω/2.
+                let xi = 0.5 * s.damping_stiffness * w;
+                h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
+            }
+            radius = radius.min(b.model.particle_radius);
+        }
+        let stable = (s.dt / (s.stability_margin * h_max)).ceil();
+        let mut needed = if stable.is_finite() { stable as u32 } else { 1 };
+        let jump = self.tool_jump_distance();
+        let tools = self.tools.iter().flatten().map(|s| &s.tool);
+        for t in tools.filter(|t| t.travel() <= jump) {
+            let sweep = (t.travel() / radius).ceil();
+            if sweep.is_finite() {
+                needed = needed.max(sweep.min(u32::MAX as Real) as u32);
+            }
+        }
+        let n = needed.max(s.min_substeps);
+        if n > s.max_substeps {
+            (s.max_substeps, true)
+        } else {
+            (n, false)
+        }
+    }
+}
