@@ -1,5 +1,6 @@
-//! Stateless PBD/XPBD projection kernels. Constraint storage and the solver loop live in
-//! [`crate::world`]; each kernel takes positions and inverse masses and moves them.
+//! Stateless PBD/XPBD projection kernels. The solver loop lives in [`crate::solver`], the
+//! multipliers in its workspace (volume) and in the scene's tool slots (grasp, needle); each
+//! kernel takes positions and inverse masses and moves them.
 
 pub mod contact;
 pub mod friction;

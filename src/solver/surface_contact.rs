@@ -72,7 +72,7 @@ pub(crate) const MAX_CORNER_SHARE: Real = 2.0;
 /// The passes stop when the largest correction of a pass is below this fraction of the skin.
 pub(crate) const SURFACE_PASS_TOLERANCE: Real = 0.01;
 
-/// Scratch memory of this pass, kept by the world between steps: parry's EPA (penetration
+/// Scratch memory of this pass, kept by the pipeline between steps: parry's EPA (penetration
 /// depth), its buffers reused from one query to the next, and the triangles near the tool.
 pub(crate) struct SurfaceScratch {
     epa: EPA,
