@@ -69,7 +69,7 @@ use parry3d_f64::shape::Triangle;
 /// rest are not in contact.
 pub(crate) const SELF_CONTACT_SKIN: Real = 0.5;
 
-/// Scratch memory of this pass, kept by the world between steps, sized for the largest body.
+/// Scratch memory of this pass, kept by the pipeline between steps, sized for the largest body.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SelfContactScratch {
     grid: TriangleGrid,
