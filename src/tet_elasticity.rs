@@ -118,6 +118,22 @@ impl TetElements {
         [-(b1 + b2 + b3), b1, b2, b3]
     }
 
+    /// The number of chunks of four tetrahedra (the last one padded).
+    pub(crate) fn chunk_count(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// The volume ratios `V/V₀` (dimensionless) at positions `x` (m) of the tetrahedra
+    /// `4 c .. 4 c + 4` (chunk `c`; a padded lane repeats the chunk's last tetrahedron).
+    pub(crate) fn chunk_volume_ratios(&self, c: usize, x: &[Vec3]) -> [Real; LANES] {
+        let chunk = &self.chunks[c];
+        let corner = |k: usize| V4::from_refs(chunk.tets.each_ref().map(|tet| &x[tet[k] as usize]));
+        let origin = corner(0);
+        let (e1, e2, e3) = (corner(1) - origin, corner(2) - origin, corner(3) - origin);
+        let six_volume = e1.dot(&e2.cross(&e3));
+        (six_volume / (F4::splat(6.0) * chunk.volume)).to_array()
+    }
+
     /// The deformation gradient (dimensionless) of tetrahedron `t` at positions `x` (m).
     pub(crate) fn deformation_gradient(&self, t: usize, x: &[Vec3]) -> Mat3 {
         let (tet, dinv) = self.element(t);

@@ -54,7 +54,7 @@ use crate::math::{Real, Vec3};
 use crate::parallel::{Pool, SharedSlice};
 use crate::particles::{ParticleView, ParticleViews};
 use crate::scene::{Scene, StepReport, ToolSlot};
-use crate::settings::{ContactMode, VolumeScheme, MAX_THREADS};
+use crate::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
 use parry3d_f64::math::{Isometry, Point};
 
 /// The bodies' particle views over their step scratch, by body index.
@@ -278,6 +278,9 @@ impl Pipeline {
                         VolumeScheme::DualCells => {
                             volume::project_dual_cells(body, scratch, h, &self.pool)
                         }
+                    }
+                    if body.elastic_scheme == ElasticScheme::Tetrahedra {
+                        volume::project_crushed_tets(body, scratch);
                     }
                 }
             }
