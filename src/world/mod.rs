@@ -7,8 +7,8 @@
 mod saved_state;
 mod state;
 
-use crate::body::{Body, BodyOptions};
-use crate::body_model::BodyModel;
+use crate::body::Body;
+use crate::body_model::{BodyModel, BodyOptions};
 use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::error::Error;
