@@ -31,6 +31,7 @@ pub(crate) mod colouring;
 pub(crate) mod consistency;
 pub(crate) mod constraints;
 pub mod cut;
+pub(crate) mod derived;
 pub(crate) mod divergence;
 pub(crate) mod dual_cells;
 pub(crate) mod elastic;
