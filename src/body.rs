@@ -110,8 +110,8 @@ pub struct Body {
     /// `active_before[i]`: how many of the particles before `i` are not inert (length:
     /// particles + 1). An inert particle is fixed, and so is every one of its neighbours: its
     /// elastic terms act only on fixed particles, whose forces a step does not use, so the
-    /// step's force pass skips it ([`ForceInputs::active_before`]). Follows the fixed flags
-    /// ([`Body::fixed_flags_changed`]).
+    /// step's force pass skips it (`elastic::ForceInputs::active_before`). Follows the fixed
+    /// flags ([`Body::fixed_flags_changed`]).
     pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::cut::CutState>>,
@@ -206,7 +206,8 @@ impl Body {
         &self.model.mass
     }
     /// Inertial particle masses (kg), one per particle: the physical mass plus the mass added
-    /// by [`Settings::mass_scaling`]. Momentum is `Σ inertial_mass · v`.
+    /// by [`Settings::mass_scaling`](crate::Settings::mass_scaling). Momentum is
+    /// `Σ inertial_mass · v`.
     pub fn inertial_masses(&self) -> &[Real] {
         &self.derived.inertial_mass
     }
