@@ -1,114 +1,20 @@
 //! A deformable body in a world: its shared load-time model ([`BodyModel`]: rest data,
-//! neighbourhoods, masses), the elastic constants and mass scaling under the world's settings,
-//! the fixed particles and the particle state.
+//! neighbourhoods, masses), what it derives from the world's settings ([`Derived`]: elastic
+//! constants, volume compliance, inertial masses, stability estimate), the fixed particles and
+//! the particle state.
 //!
 //! A body stores its particles in particle order, the mesh's nodes sorted for memory locality
 //! ([`ParticleOrder`]); its Rust API speaks that order, the C ABI and the FMU the mesh's.
 
-use crate::body_model::BodyModel;
-use crate::elastic::{self, ElasticModel, ForceInputs};
-use crate::error::{check_finite, check_positive, Error};
+use crate::body_model::{BodyModel, Material};
+use crate::derived::{Derived, DerivedFrom};
+use crate::elastic::{self, ElasticModel};
 use crate::lanes::{F4, LANES, V4};
 use crate::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
-use crate::neighbours::{self, Neighbourhoods};
+use crate::neighbours::Neighbourhoods;
 use crate::parallel::{Pool, SharedSlice};
 use crate::particle_order::ParticleOrder;
-use crate::settings::{ElasticScheme, Settings};
-use crate::tet_elasticity::{self, TetForceInputs};
 use std::sync::Arc;
-
-/// An isotropic linear-elastic material (SI units).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Material {
-    /// Young's modulus E (Pa).
-    pub youngs_modulus: Real,
-    /// Poisson ratio ν (dimensionless, in [0, 0.499]: see [`MAX_POISSON_RATIO`]).
-    pub poisson_ratio: Real,
-    /// Mass density ρ (kg/m³).
-    pub density: Real,
-}
-
-/// The range of Poisson ratios a body accepts: `[MIN_POISSON_RATIO, MAX_POISSON_RATIO]`.
-///
-/// Below 0 a material is auxetic (it widens when stretched): no soft tissue is, and the
-/// corotated stress with volume constraints was seen to explode there (ν = −0.5 and
-/// ν → −1 turned organs inside out under a probe). Towards 0.5 the volumetric stiffness
-/// λ = Eν/((1+ν)(1−2ν)) diverges (λ/μ = 2ν/(1−2ν) is 98 at 0.49, 499 at 0.499, ∞ at 0.5).
-/// Soft tissue lies at 0.45–0.499; up to 0.499 the volume constraints carry λ implicitly
-/// (XPBD), so the step does not stiffen: liver_4k sagging 7 cm keeps its volume within 0.25%
-/// at 0.499 (0.5% at 0.49). With the volume constraints off the particles carry λ
-/// explicitly, and the mass scaling that keeps such a step stable grows with λ (slow,
-/// heavy dynamics near 0.5).
-pub const MIN_POISSON_RATIO: Real = 0.0;
-/// See [`MIN_POISSON_RATIO`].
-pub const MAX_POISSON_RATIO: Real = 0.499;
-
-/// Accepted Young's moduli (Pa): from 10⁻⁶ Pa (far softer than any tissue, and well above the
-/// denormal numbers, whose arithmetic is slow and loses precision) to 10¹² Pa (stiffer than
-/// diamond; beyond it stresses overflow long before the explicit step could resolve them).
-pub const YOUNGS_MODULUS_RANGE: (Real, Real) = (1e-6, 1e12);
-
-/// Accepted densities (kg/m³): from 10⁻⁶ (models in mesh units use ρ = 1) to 10⁵ (four times
-/// osmium, the densest element).
-pub const DENSITY_RANGE: (Real, Real) = (1e-6, 1e5);
-
-impl Material {
-    /// Check the material: NaN or ±Inf give [`Error::NonFinite`]; E outside
-    /// [`YOUNGS_MODULUS_RANGE`], ν outside [[`MIN_POISSON_RATIO`], [`MAX_POISSON_RATIO`]] or ρ
-    /// outside [`DENSITY_RANGE`] give [`Error::InvalidArgument`], the message naming the field,
-    /// the range and why. The one validation of materials, used when a body is built, by the C
-    /// API and by the FMU.
-    pub fn validate(&self) -> Result<(), Error> {
-        check_finite("material.youngs_modulus", self.youngs_modulus)?;
-        check_finite("material.poisson_ratio", self.poisson_ratio)?;
-        check_finite("material.density", self.density)?;
-        let bad = |s: String| Err(Error::InvalidArgument(s));
-        let (e_lo, e_hi) = YOUNGS_MODULUS_RANGE;
-        if !(e_lo..=e_hi).contains(&self.youngs_modulus) {
-            return bad(format!(
-                "material.youngs_modulus must be in [{e_lo:e}, {e_hi:e}] Pa, got {:e}",
-                self.youngs_modulus
-            ));
-        }
-        let nu = self.poisson_ratio;
-        if !(MIN_POISSON_RATIO..=MAX_POISSON_RATIO).contains(&nu) {
-            return bad(format!(
-                "material.poisson_ratio must be in [{MIN_POISSON_RATIO}, {MAX_POISSON_RATIO}], got {nu}: \
-                 negative values are auxetic (not tissue) and unstable here, and the volumetric \
-                 stiffness lambda = E nu / ((1 + nu)(1 - 2 nu)) diverges as nu -> 0.5"
-            ));
-        }
-        let (d_lo, d_hi) = DENSITY_RANGE;
-        if !(d_lo..=d_hi).contains(&self.density) {
-            return bad(format!(
-                "material.density must be in [{d_lo:e}, {d_hi:e}] kg/m3, got {:e}",
-                self.density
-            ));
-        }
-        Ok(())
-    }
-    /// First Lamé parameter λ = Eν / ((1 + ν)(1 - 2ν)) (Pa): under the volumetric split the
-    /// volume constraints get compliance `1/λ`.
-    pub fn lame_lambda(&self) -> Real {
-        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
-        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    }
-    /// Shear modulus μ = E / (2(1 + ν)) (Pa).
-    pub fn shear_modulus(&self) -> Real {
-        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
-    }
-}
-
-impl Default for Material {
-    /// Liver-like soft tissue: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.
-    fn default() -> Self {
-        Material {
-            youngs_modulus: 5.0e3,
-            poisson_ratio: 0.45,
-            density: 1060.0,
-        }
-    }
-}
 
 /// Largest distance (in body sizes: the diagonal of the rest bounding box) of a particle from
 /// the centre of its body's rest bounding box that [`World::set_body_state`] and
@@ -125,104 +31,6 @@ pub const STATE_POSITION_LIMIT: Real = 100.0;
 /// [`World::set_body_state`]: crate::World::set_body_state
 /// [`World::restore_state`]: crate::World::restore_state
 pub const STATE_SPEED_LIMIT: Real = 1000.0;
-
-/// Options for building a body.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BodyOptions {
-    /// The material.
-    pub material: Material,
-    /// Support radius of every particle (m); `None` chooses one per particle so that its moment
-    /// matrix is well conditioned.
-    pub support_radius: Option<Real>,
-    /// Target number of neighbours when the support radius is chosen automatically.
-    pub target_neighbours: u32,
-    /// Contact radius of the particles (m) for organ–organ contact and the sampled-points tool
-    /// contact (tools in the exact-shape mode touch the boundary triangles, with a skin of a
-    /// tenth of this radius); `None` takes half the mean tetrahedron edge.
-    pub particle_radius: Option<Real>,
-    /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
-    /// divergence theorem (variationally consistent integration, Chen, Hillman & Rüter 2013): a
-    /// uniform stress then leaves interior particles in equilibrium on any point set, and the
-    /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
-    /// gradients of the paper (for comparison only).
-    pub consistent_gradients: bool,
-}
-
-/// Accepted range of [`BodyOptions::particle_radius`], in mean tetrahedron edge lengths: a
-/// radius far below the spacing lets particles pass between each other and makes every swept
-/// tool motion need countless substeps; far above it, neighbouring particles of one body
-/// overlap and tool contact pushes whole regions at once.
-pub const PARTICLE_RADIUS_RANGE: (Real, Real) = (0.05, 2.0);
-
-/// Accepted range of [`BodyOptions::support_radius`], in mean tetrahedron edge lengths: below,
-/// a particle has too few neighbours for a well-conditioned moment matrix; above, the neighbour
-/// count (and the memory and time of every step) grows with the cube of the radius.
-pub const SUPPORT_RADIUS_RANGE: (Real, Real) = (0.5, 3.0);
-
-impl BodyOptions {
-    /// Check the options: the material ([`Material::validate`]), radii finite and > 0 m when
-    /// given, `target_neighbours` ≥ 1. NaN or ±Inf give [`Error::NonFinite`], other bad values
-    /// [`Error::InvalidArgument`]. Used when a body is built and by the C API.
-    pub fn validate(&self) -> Result<(), Error> {
-        self.material.validate()?;
-        if let Some(r) = self.support_radius {
-            check_positive("options.support_radius", r, "m")?;
-        }
-        if let Some(r) = self.particle_radius {
-            check_positive("options.particle_radius", r, "m")?;
-        }
-        if self.target_neighbours == 0 {
-            return Err(Error::InvalidArgument(
-                "options.target_neighbours must be >= 1".into(),
-            ));
-        }
-        Ok(())
-    }
-
-    /// Check the material and the radii against a mesh of mean edge length `mean_edge` (m):
-    /// explicit radii must lie in [`PARTICLE_RADIUS_RANGE`] and [`SUPPORT_RADIUS_RANGE`] (in
-    /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](crate::MAX_NEIGHBOURS).
-    pub fn check_radii(&self, mean_edge: Real) -> Result<(), Error> {
-        self.validate()?;
-        for (name, value, (lo, hi)) in [
-            (
-                "particle_radius",
-                self.particle_radius,
-                PARTICLE_RADIUS_RANGE,
-            ),
-            ("support_radius", self.support_radius, SUPPORT_RADIUS_RANGE),
-        ] {
-            let Some(r) = value else { continue };
-            let (min, max) = (lo * mean_edge, hi * mean_edge);
-            if !(r.is_finite() && r >= min && r <= max) {
-                return Err(Error::InvalidArgument(format!(
-                    "{name} {r:e} m is outside [{min:.3e}, {max:.3e}] m, i.e. [{lo}, {hi}] x the \
-                     mesh's mean edge length {mean_edge:.3e} m"
-                )));
-            }
-        }
-        let k = self.target_neighbours as usize;
-        if !(1..=neighbours::MAX_NEIGHBOURS).contains(&k) {
-            return Err(Error::InvalidArgument(format!(
-                "target_neighbours must be in 1..={}, got {k}",
-                neighbours::MAX_NEIGHBOURS
-            )));
-        }
-        Ok(())
-    }
-}
-
-impl Default for BodyOptions {
-    fn default() -> Self {
-        BodyOptions {
-            material: Material::default(),
-            support_radius: None,
-            target_neighbours: 20,
-            particle_radius: None,
-            consistent_gradients: true,
-        }
-    }
-}
 
 /// The dynamic state of a body's particles: what a step advances; part of the
 /// [`WorldState`](crate::WorldState).
@@ -289,12 +97,12 @@ impl ParticleState {
 pub struct Body {
     /// The load-time data, shared with every other body built from the same model.
     pub(crate) model: Arc<BodyModel>,
-    /// The elastic constants under the world's settings.
-    pub(crate) elastic: ElasticModel,
+    /// What the world's settings and the model determine: elastic constants, volume
+    /// compliance, inertial masses, stability estimate, with the settings they were derived
+    /// under. Re-derived by `World::set_settings` when those change, kept stable by a cut.
+    pub(crate) derived: Derived,
     /// Positions, velocities and rotations of the particles: what a step advances.
     pub(crate) state: ParticleState,
-    /// Inertial masses (kg): the physical mass plus any mass scaling.
-    pub(crate) inertial_mass: Vec<Real>,
     /// Inverse inertial masses (1/kg), 0 for fixed particles.
     pub(crate) inv_mass: Vec<Real>,
     /// Fixed flags.
@@ -302,64 +110,41 @@ pub struct Body {
     /// `active_before[i]`: how many of the particles before `i` are not inert (length:
     /// particles + 1). An inert particle is fixed, and so is every one of its neighbours: its
     /// elastic terms act only on fixed particles, whose forces a step does not use, so the
-    /// step's force pass skips it ([`ForceInputs::active_before`]). Follows the fixed flags
-    /// ([`Body::fixed_flags_changed`]).
+    /// step's force pass skips it (`elastic::ForceInputs::active_before`). Follows the fixed
+    /// flags ([`Body::fixed_flags_changed`]).
     pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::cut::CutState>>,
-    /// Compliance of the volume constraints per unit rest volume (1/Pa); ∞ (ν = 0 under the
-    /// split) disables them.
-    pub(crate) volume_compliance: Real,
-    /// Whether the world projects the volume constraints (`Settings::volume_constraints`).
-    pub(crate) volume_constraints_on: bool,
-    /// What each volume constraint keeps (`Settings::volume_scheme`).
-    pub(crate) volume_scheme: crate::VolumeScheme,
-    /// What carries the elasticity (`Settings::elastic_scheme`).
-    pub(crate) elastic_scheme: ElasticScheme,
-    /// Largest angular frequency of the linearised elastic system at rest (rad/s).
-    pub(crate) omega_max: Real,
-    /// The same with the physical masses, once estimated: it depends on the model and the
-    /// elastic model alone, so a change of the time step (an FMU master varying its step)
-    /// does not estimate it again. A cut forgets it.
-    pub(crate) omega_physical: Option<Real>,
 }
-
-/// The most volumetric stiffness λ/μ (dimensionless) that corotated tetrahedra keep in their
-/// stress when the dual cells carry the volume (`ElasticScheme::Tetrahedra` with
-/// `VolumeScheme::DualCells`): 1.5, a material of ν = 0.3 (λ/μ = 2ν/(1 - 2ν)). Up to it linear
-/// tetrahedra do not lock (their static error at ν 0.3 is that of the mesh); the dual cells
-/// alone are too soft there (their nodal volumes have spurious modes the tetrahedra
-/// suppress). Above it the dual cells carry the rest, so nearly incompressible tissue does not
-/// lock. Measured on eight organ meshes against FEM references in docs/VALIDATION.md.
-pub(crate) const TETRAHEDRON_LAMBDA_OVER_MU: Real = 1.5;
 
 /// Newton iterations of the rotation extraction per particle per substep before the exact SVD
 /// fallback (warm-started, they converge in 1–3).
 pub(crate) const ROTATION_ITERATIONS: u32 = 6;
 
 impl Body {
-    /// A body at rest, nothing fixed, on `model` (shared, not copied) under `settings`.
-    pub(crate) fn from_model(model: Arc<BodyModel>, settings: &Settings) -> Body {
+    /// A body at rest, nothing fixed, on `model` (shared, not copied), its data derived under
+    /// `from`.
+    pub(crate) fn from_model(model: Arc<BodyModel>, from: DerivedFrom) -> Body {
         let n = model.particle_count();
-        let m = model.options.material;
         let mut body = Body {
-            elastic: ElasticModel::new(m.youngs_modulus, m.poisson_ratio, 0.0, 0.0),
+            derived: Derived::new(&model, from),
             state: ParticleState::at_rest(&model.rest),
             inv_mass: vec![0.0; n],
-            inertial_mass: model.mass.clone(),
             fixed: vec![false; n],
             active_before: (0..=n as u32).collect(),
             cuts: None,
-            omega_max: 0.0,
-            omega_physical: None,
-            volume_compliance: 0.0,
-            volume_constraints_on: false,
-            volume_scheme: crate::VolumeScheme::Tetrahedra,
-            elastic_scheme: ElasticScheme::PointBased,
             model,
         };
-        body.configure(settings);
+        body.update_inverse_masses();
         body
+    }
+
+    /// Re-derive the body's data under `from` ([`Derived::rederive`]): nothing when they were
+    /// derived under it already.
+    pub(crate) fn rederive(&mut self, from: DerivedFrom) {
+        if self.derived.rederive(&self.model, from) {
+            self.update_inverse_masses();
+        }
     }
 
     /// Check a particle state against [`STATE_POSITION_LIMIT`] and [`STATE_SPEED_LIMIT`]
@@ -421,13 +206,14 @@ impl Body {
         &self.model.mass
     }
     /// Inertial particle masses (kg), one per particle: the physical mass plus the mass added
-    /// by [`Settings::mass_scaling`]. Momentum is `Σ inertial_mass · v`.
+    /// by [`Settings::mass_scaling`](crate::Settings::mass_scaling). Momentum is
+    /// `Σ inertial_mass · v`.
     pub fn inertial_masses(&self) -> &[Real] {
-        &self.inertial_mass
+        &self.derived.inertial_mass
     }
     /// Total inertial mass added by mass scaling (kg).
     pub fn added_mass(&self) -> Real {
-        self.inertial_mass.iter().sum::<Real>() - self.mass()
+        self.derived.inertial_mass.iter().sum::<Real>() - self.mass()
     }
     /// Tetrahedra (4 particle indices each).
     pub fn tets(&self) -> &[[u32; 4]] {
@@ -496,7 +282,7 @@ impl Body {
     /// The elastic model in force: Lamé parameters of the particle stress (λ is 0 when the
     /// volumetric split moves it into the volume constraints), hourglass and damping terms.
     pub fn elastic_model(&self) -> &ElasticModel {
-        &self.elastic
+        &self.derived.elastic
     }
     /// The material.
     pub fn material(&self) -> &Material {
@@ -505,7 +291,7 @@ impl Body {
     /// Largest angular frequency (rad/s) of the body's linearised elastic vibrations at rest,
     /// the quantity that sets the explicit stability limit `2/ω_max` of a substep.
     pub fn max_angular_frequency(&self) -> Real {
-        self.omega_max
+        self.derived.omega_max
     }
 
     /// Deformation gradient of particle `i` if the particles were at `positions` (m).
@@ -514,160 +300,21 @@ impl Body {
     }
 
     /// Elastic (and hourglass) forces (N) on every particle if the particles were at
-    /// `positions` (m) with zero velocity, from the elasticity of `Settings::elastic_scheme`;
-    /// an analysis helper that allocates.
+    /// `positions` (m) with zero velocity, from the elasticity of the world's
+    /// `Settings::elastic_scheme`; an analysis helper that allocates.
     pub fn elastic_forces_at(&self, positions: &[Vec3]) -> Vec<Vec3> {
-        let mut force = vec![Vec3::zeros(); self.state.x.len()];
-        if self.elastic_scheme == ElasticScheme::Tetrahedra {
-            let at_rest = vec![Vec3::zeros(); positions.len()];
-            let input = TetForceInputs {
-                elements: &self.model.tet_elements,
-                x: positions,
-                v: &at_rest,
-                fixed: &[],
-            };
-            // One thread keeps no corner forces.
-            tet_elasticity::accumulate_forces(
-                &self.elastic,
-                &input,
-                &mut [],
-                &mut force,
-                &Pool::new(1),
-            );
-            return force;
-        }
-        let mut rotation = vec![Quat::identity(); self.state.x.len()];
-        // One thread keeps no pair forces.
-        let (mut pair_force, mut own_force) = (Vec::new(), Vec::new());
-        let zero = vec![Vec3::zeros(); self.state.x.len()];
-        let input = ForceInputs {
-            nbr: &self.model.nbr,
-            volume: &self.model.particle_volume,
-            x: positions,
-            v: &zero,
-            active_before: &[],
-        };
-        elastic::accumulate_forces(
-            &self.elastic,
-            &input,
-            &mut rotation,
-            50,
-            &mut pair_force,
-            &mut own_force,
-            &mut force,
-            &Pool::new(1),
-        );
-        force
+        self.derived.elastic_forces_at(&self.model, positions)
     }
 
-    /// Apply the world's settings: the elastic model's hourglass and damping terms, the mass
-    /// scaling for substeps of `dt / min_substeps`, and the stability estimate. The estimate
-    /// with the physical masses is kept while the elastic model and the scheme stay the same:
-    /// a new time step costs nothing unless it needs mass scaling.
-    pub(crate) fn configure(&mut self, settings: &Settings) {
-        let before = (self.elastic, self.elastic_scheme);
-        let m = self.model.options.material;
-        self.elastic = ElasticModel::new(
-            m.youngs_modulus,
-            m.poisson_ratio,
-            settings.hourglass_stiffness,
-            settings.damping_stiffness,
-        );
-        self.volume_compliance = settings.volume_compliance;
-        self.volume_constraints_on = settings.volume_constraints;
-        self.volume_scheme = settings.volume_scheme;
-        self.elastic_scheme = settings.elastic_scheme;
-        if settings.volume_constraints && settings.volumetric_split {
-            // Tetrahedra under dual cells keep the volumetric stiffness they carry without
-            // locking; the dual cells take the rest (all of it for the other schemes).
-            let kept = match (settings.elastic_scheme, settings.volume_scheme) {
-                (ElasticScheme::Tetrahedra, crate::VolumeScheme::DualCells) => self
-                    .elastic
-                    .lambda
-                    .min(TETRAHEDRON_LAMBDA_OVER_MU * self.elastic.mu),
-                _ => 0.0,
-            };
-            self.volume_compliance += 1.0 / (self.elastic.lambda - kept);
-            self.elastic.lambda = kept;
-        }
-        if (self.elastic, self.elastic_scheme) != before {
-            self.omega_physical = None;
-        }
-        self.inertial_mass.copy_from_slice(&self.model.mass);
-        self.update_inverse_masses();
-        self.omega_max = match self.omega_physical {
-            Some(omega) => omega,
-            None => crate::stability::max_angular_frequency(
-                self.rest_positions(),
-                self.inertial_masses(),
-                |x| self.elastic_forces_at(x),
-            ),
-        };
-        self.omega_physical = Some(self.omega_max);
-        if settings.mass_scaling {
-            let h = settings.dt / settings.min_substeps as Real;
-            let omega_target = 2.0 * settings.stability_margin / h;
-            let stiffness = self.diagonal_stiffness();
-            // Local frequency ω_i² ≈ factor · k_ii / m_i; the factor starts at Gershgorin's 2 and
-            // grows until the power iteration confirms the target (a few rounds at most).
-            let mut factor = 2.0;
-            for _ in 0..4 {
-                if self.omega_max <= omega_target {
-                    break;
-                }
-                for ((mi, m0), k) in self
-                    .inertial_mass
-                    .iter_mut()
-                    .zip(&self.model.mass)
-                    .zip(&stiffness)
-                {
-                    *mi = m0.max(factor * k / (omega_target * omega_target));
-                }
-                self.update_inverse_masses();
-                self.omega_max = crate::stability::max_angular_frequency(
-                    self.rest_positions(),
-                    self.inertial_masses(),
-                    |x| self.elastic_forces_at(x),
-                );
-                factor *= (self.omega_max / omega_target).powi(2).max(1.1);
-            }
-        }
-    }
-
+    /// The inverse inertial masses from the inertial masses and the fixed flags.
     pub(crate) fn update_inverse_masses(&mut self) {
         for i in 0..self.state.x.len() {
             self.inv_mass[i] = if self.fixed[i] {
                 0.0
             } else {
-                1.0 / self.inertial_mass[i]
+                1.0 / self.derived.inertial_mass[i]
             };
         }
-    }
-
-    /// An estimate (N/m) of each particle's diagonal stiffness at rest: the elastic terms of
-    /// the pairs it belongs to (as neighbour and as centre) plus their hourglass terms, or
-    /// those of the tetrahedra around it.
-    pub(crate) fn diagonal_stiffness(&self) -> Vec<Real> {
-        let pwave = self.elastic.p_wave_modulus();
-        let mut k = vec![0.0; self.state.x.len()];
-        if self.elastic_scheme == ElasticScheme::Tetrahedra {
-            let elements = &self.model.tet_elements;
-            tet_elasticity::add_diagonal_stiffness(&self.elastic, elements, &mut k);
-            return k;
-        }
-        for (i, vi) in self.model.particle_volume.iter().enumerate() {
-            let mut dsum = Vec3::zeros();
-            for e in self.model.nbr.range(i) {
-                let j = self.model.nbr.index[e] as usize;
-                let d = self.model.nbr.gradient.get(e);
-                let hg = self.elastic.hourglass * vi * self.model.nbr.hourglass_weight[e];
-                k[j] += pwave * vi * d.norm_squared() + hg;
-                k[i] += hg;
-                dsum += d;
-            }
-            k[i] += pwave * vi * dsum.norm_squared();
-        }
-        k
     }
 
     /// Mark the `particles` fixed: zero velocity, and what follows from the fixed flags.

@@ -1,26 +1,218 @@
-//! The immutable part of a body: what a mesh and its [`BodyOptions`] determine once, at load
-//! time — rest positions, tetrahedra and their rest volumes, boundary triangles, particle
+//! The immutable part of a body: what a mesh and its [`BodyOptions`] (the [`Material`] and the
+//! neighbourhood and contact radii, defined here beside the model they build) determine once,
+//! at load time — rest positions, tetrahedra and their rest volumes, boundary triangles, particle
 //! volumes and masses, and the neighbourhoods with their (variationally consistent) gradient
 //! coefficients, the costly part of loading.
 //!
 //! A [`BodyModel`] is shared behind an [`Arc`]: every world (or FMU instance) built from the
 //! same mesh and options may hold the same one ([`World::add_body_model`](crate::World::add_body_model)).
-//! What the world's settings and the scene change — the elastic constants under the settings,
-//! the mass scaling, the fixed particles, the particle state — lives in [`Body`](crate::Body).
+//! What the world's settings and the scene change — the data derived under the settings
+//! (elastic constants, mass scaling: `src/derived.rs`), the fixed particles, the particle state
+//! — lives in [`Body`](crate::Body).
 //! A cut is the one operation that changes a model; it makes the cut body's own copy first
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 
-use crate::body::BodyOptions;
 use crate::colouring::TetColouring;
 use crate::consistency;
 use crate::dual_cells::DualCells;
-use crate::error::Error;
+use crate::error::{check_finite, check_positive, Error};
 use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::neighbours::{self, Neighbourhoods, SupportRadius};
 use crate::particle_order::ParticleOrder;
 use crate::tet_elasticity::TetElements;
 use std::sync::Arc;
+
+/// An isotropic linear-elastic material (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: Real,
+    /// Poisson ratio ν (dimensionless, in [0, 0.499]: see [`MAX_POISSON_RATIO`]).
+    pub poisson_ratio: Real,
+    /// Mass density ρ (kg/m³).
+    pub density: Real,
+}
+
+/// The range of Poisson ratios a body accepts: `[MIN_POISSON_RATIO, MAX_POISSON_RATIO]`.
+///
+/// Below 0 a material is auxetic (it widens when stretched): no soft tissue is, and the
+/// corotated stress with volume constraints was seen to explode there (ν = −0.5 and
+/// ν → −1 turned organs inside out under a probe). Towards 0.5 the volumetric stiffness
+/// λ = Eν/((1+ν)(1−2ν)) diverges (λ/μ = 2ν/(1−2ν) is 98 at 0.49, 499 at 0.499, ∞ at 0.5).
+/// Soft tissue lies at 0.45–0.499; up to 0.499 the volume constraints carry λ implicitly
+/// (XPBD), so the step does not stiffen: liver_4k sagging 7 cm keeps its volume within 0.25%
+/// at 0.499 (0.5% at 0.49). With the volume constraints off the particles carry λ
+/// explicitly, and the mass scaling that keeps such a step stable grows with λ (slow,
+/// heavy dynamics near 0.5).
+pub const MIN_POISSON_RATIO: Real = 0.0;
+/// See [`MIN_POISSON_RATIO`].
+pub const MAX_POISSON_RATIO: Real = 0.499;
+
+/// Accepted Young's moduli (Pa): from 10⁻⁶ Pa (far softer than any tissue, and well above the
+/// denormal numbers, whose arithmetic is slow and loses precision) to 10¹² Pa (stiffer than
+/// diamond; beyond it stresses overflow long before the explicit step could resolve them).
+pub const YOUNGS_MODULUS_RANGE: (Real, Real) = (1e-6, 1e12);
+
+/// Accepted densities (kg/m³): from 10⁻⁶ (models in mesh units use ρ = 1) to 10⁵ (four times
+/// osmium, the densest element).
+pub const DENSITY_RANGE: (Real, Real) = (1e-6, 1e5);
+
+impl Material {
+    /// Check the material: NaN or ±Inf give [`Error::NonFinite`]; E outside
+    /// [`YOUNGS_MODULUS_RANGE`], ν outside [[`MIN_POISSON_RATIO`], [`MAX_POISSON_RATIO`]] or ρ
+    /// outside [`DENSITY_RANGE`] give [`Error::InvalidArgument`], the message naming the field,
+    /// the range and why. The one validation of materials, used when a body is built, by the C
+    /// API and by the FMU.
+    pub fn validate(&self) -> Result<(), Error> {
+        check_finite("material.youngs_modulus", self.youngs_modulus)?;
+        check_finite("material.poisson_ratio", self.poisson_ratio)?;
+        check_finite("material.density", self.density)?;
+        let bad = |s: String| Err(Error::InvalidArgument(s));
+        let (e_lo, e_hi) = YOUNGS_MODULUS_RANGE;
+        if !(e_lo..=e_hi).contains(&self.youngs_modulus) {
+            return bad(format!(
+                "material.youngs_modulus must be in [{e_lo:e}, {e_hi:e}] Pa, got {:e}",
+                self.youngs_modulus
+            ));
+        }
+        let nu = self.poisson_ratio;
+        if !(MIN_POISSON_RATIO..=MAX_POISSON_RATIO).contains(&nu) {
+            return bad(format!(
+                "material.poisson_ratio must be in [{MIN_POISSON_RATIO}, {MAX_POISSON_RATIO}], got {nu}: \
+                 negative values are auxetic (not tissue) and unstable here, and the volumetric \
+                 stiffness lambda = E nu / ((1 + nu)(1 - 2 nu)) diverges as nu -> 0.5"
+            ));
+        }
+        let (d_lo, d_hi) = DENSITY_RANGE;
+        if !(d_lo..=d_hi).contains(&self.density) {
+            return bad(format!(
+                "material.density must be in [{d_lo:e}, {d_hi:e}] kg/m3, got {:e}",
+                self.density
+            ));
+        }
+        Ok(())
+    }
+    /// First Lamé parameter λ = Eν / ((1 + ν)(1 - 2ν)) (Pa): under the volumetric split the
+    /// volume constraints get compliance `1/λ`.
+    pub fn lame_lambda(&self) -> Real {
+        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    }
+    /// Shear modulus μ = E / (2(1 + ν)) (Pa).
+    pub fn shear_modulus(&self) -> Real {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+}
+
+impl Default for Material {
+    /// Liver-like soft tissue: E = 5 kPa, ν = 0.45, ρ = 1060 kg/m³.
+    fn default() -> Self {
+        Material {
+            youngs_modulus: 5.0e3,
+            poisson_ratio: 0.45,
+            density: 1060.0,
+        }
+    }
+}
+
+/// Options for building a body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyOptions {
+    /// The material.
+    pub material: Material,
+    /// Support radius of every particle (m); `None` chooses one per particle so that its moment
+    /// matrix is well conditioned.
+    pub support_radius: Option<Real>,
+    /// Target number of neighbours when the support radius is chosen automatically.
+    pub target_neighbours: u32,
+    /// Contact radius of the particles (m) for organ–organ contact and the sampled-points tool
+    /// contact (tools in the exact-shape mode touch the boundary triangles, with a skin of a
+    /// tenth of this radius); `None` takes half the mean tetrahedron edge.
+    pub particle_radius: Option<Real>,
+    /// Correct the MLS gradients at load time so that nodal integration satisfies the discrete
+    /// divergence theorem (variationally consistent integration, Chen, Hillman & Rüter 2013): a
+    /// uniform stress then leaves interior particles in equilibrium on any point set, and the
+    /// response does not depend on how irregular the mesh is. `false` keeps the plain MLS
+    /// gradients of the paper (for comparison only).
+    pub consistent_gradients: bool,
+}
+
+/// Accepted range of [`BodyOptions::particle_radius`], in mean tetrahedron edge lengths: a
+/// radius far below the spacing lets particles pass between each other and makes every swept
+/// tool motion need countless substeps; far above it, neighbouring particles of one body
+/// overlap and tool contact pushes whole regions at once.
+pub const PARTICLE_RADIUS_RANGE: (Real, Real) = (0.05, 2.0);
+
+/// Accepted range of [`BodyOptions::support_radius`], in mean tetrahedron edge lengths: below,
+/// a particle has too few neighbours for a well-conditioned moment matrix; above, the neighbour
+/// count (and the memory and time of every step) grows with the cube of the radius.
+pub const SUPPORT_RADIUS_RANGE: (Real, Real) = (0.5, 3.0);
+
+impl BodyOptions {
+    /// Check the options: the material ([`Material::validate`]), radii finite and > 0 m when
+    /// given, `target_neighbours` ≥ 1. NaN or ±Inf give [`Error::NonFinite`], other bad values
+    /// [`Error::InvalidArgument`]. Used when a body is built and by the C API.
+    pub fn validate(&self) -> Result<(), Error> {
+        self.material.validate()?;
+        if let Some(r) = self.support_radius {
+            check_positive("options.support_radius", r, "m")?;
+        }
+        if let Some(r) = self.particle_radius {
+            check_positive("options.particle_radius", r, "m")?;
+        }
+        if self.target_neighbours == 0 {
+            return Err(Error::InvalidArgument(
+                "options.target_neighbours must be >= 1".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Check the material and the radii against a mesh of mean edge length `mean_edge` (m):
+    /// explicit radii must lie in [`PARTICLE_RADIUS_RANGE`] and [`SUPPORT_RADIUS_RANGE`] (in
+    /// mean edge lengths), `target_neighbours` in 1..=[`MAX_NEIGHBOURS`](crate::MAX_NEIGHBOURS).
+    pub fn check_radii(&self, mean_edge: Real) -> Result<(), Error> {
+        self.validate()?;
+        for (name, value, (lo, hi)) in [
+            (
+                "particle_radius",
+                self.particle_radius,
+                PARTICLE_RADIUS_RANGE,
+            ),
+            ("support_radius", self.support_radius, SUPPORT_RADIUS_RANGE),
+        ] {
+            let Some(r) = value else { continue };
+            let (min, max) = (lo * mean_edge, hi * mean_edge);
+            if !(r.is_finite() && r >= min && r <= max) {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} {r:e} m is outside [{min:.3e}, {max:.3e}] m, i.e. [{lo}, {hi}] x the \
+                     mesh's mean edge length {mean_edge:.3e} m"
+                )));
+            }
+        }
+        let k = self.target_neighbours as usize;
+        if !(1..=neighbours::MAX_NEIGHBOURS).contains(&k) {
+            return Err(Error::InvalidArgument(format!(
+                "target_neighbours must be in 1..={}, got {k}",
+                neighbours::MAX_NEIGHBOURS
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Default for BodyOptions {
+    fn default() -> Self {
+        BodyOptions {
+            material: Material::default(),
+            support_radius: None,
+            target_neighbours: 20,
+            particle_radius: None,
+            consistent_gradients: true,
+        }
+    }
+}
 
 /// The load-time data of a body (see the module documentation).
 #[derive(Debug, Clone, PartialEq)]

@@ -24,6 +24,7 @@
 use crate::body::Body;
 use crate::body_model::BodyModel;
 use crate::colouring::TetColouring;
+use crate::derived::StabilityBase;
 use crate::dual_cells::DualCells;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
@@ -60,9 +61,8 @@ pub(crate) struct CutState {
     /// The model as loaded (shared with the other holders of it: the cut body works on its own
     /// copy from the first cut on).
     original: Arc<BodyModel>,
-    /// Load-time inertial masses (kg) and diagonal stiffnesses (N/m) of the particles.
-    inertial_mass: Vec<Real>,
-    stiffness: Vec<Real>,
+    /// The inertial masses and diagonal stiffnesses of the particles before the first cut.
+    base: StabilityBase,
     /// Per pair (load-time order): cut.
     pub(crate) pair_cut: Vec<bool>,
     /// Per load-time tetrahedron: removed.
@@ -75,8 +75,7 @@ impl CutState {
     fn new(body: &Body) -> CutState {
         CutState {
             original: Arc::clone(&body.model),
-            inertial_mass: body.inertial_mass.clone(),
-            stiffness: body.diagonal_stiffness(),
+            base: body.derived.stability_base(&body.model),
             pair_cut: vec![false; body.model.nbr.slot_count()],
             tet_cut: vec![false; body.model.tets.len()],
             sets: Arc::default(),
@@ -246,39 +245,11 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
     };
     model.boundary = mesh.boundary_triangles();
     model.boundary_vertices = crate::mesh::boundary_vertices(&model.boundary);
-    restabilise(body, &state);
+    // Keep the step stable on the new topology.
+    body.derived.restabilise(&body.model, &state.base);
+    body.update_inverse_masses();
     body.cuts = Some(state);
     isolated
-}
-
-/// Keep the step stable after a change of topology. With mass scaling (load-time inertial
-/// masses above the physical ones), a particle whose diagonal stiffness rose above its load-time
-/// value gets its load-time inertial mass scaled by the same factor, so its local frequency
-/// stays where mass scaling put it; a function of the current topology only, so restoring a
-/// state reproduces it. Without mass scaling, the stability limit is estimated anew. Either
-/// way the estimate with the physical masses, which the new topology changes, is forgotten.
-fn restabilise(body: &mut Body, state: &CutState) {
-    body.omega_physical = None;
-    let scaled = state
-        .inertial_mass
-        .iter()
-        .zip(&body.model.mass)
-        .any(|(mi, m)| mi > m);
-    if scaled {
-        let now = body.diagonal_stiffness();
-        let base = state.inertial_mass.iter().zip(&state.stiffness);
-        for ((mi, (m0, k0)), k) in body.inertial_mass.iter_mut().zip(base).zip(&now) {
-            let ratio = if *k0 > 0.0 { (k / k0).max(1.0) } else { 1.0 };
-            *mi = m0 * ratio;
-        }
-        body.update_inverse_masses();
-    } else {
-        body.omega_max = crate::stability::max_angular_frequency(
-            body.rest_positions(),
-            body.inertial_masses(),
-            |x| body.elastic_forces_at(x),
-        );
-    }
 }
 
 /// The particle whose neighbourhood holds pair `e`.

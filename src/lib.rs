@@ -31,6 +31,7 @@ pub(crate) mod colouring;
 pub(crate) mod consistency;
 pub(crate) mod constraints;
 pub mod cut;
+pub(crate) mod derived;
 pub(crate) mod divergence;
 pub(crate) mod dual_cells;
 pub(crate) mod elastic;
@@ -61,12 +62,11 @@ pub(crate) mod tet_elasticity;
 pub(crate) mod vec3_array;
 pub(crate) mod world;
 
-pub use body::{
-    Body, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
-    PARTICLE_RADIUS_RANGE, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT, SUPPORT_RADIUS_RANGE,
-    YOUNGS_MODULUS_RANGE,
+pub use body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
+pub use body_model::{
+    BodyModel, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
+    PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
 };
-pub use body_model::BodyModel;
 pub use collision::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,

@@ -15,8 +15,13 @@
 //! `Σ_i v_i Ψ(F_i)`, the hourglass term, and — when the volume constraints carry the
 //! volumetric stiffness — each constraint's `(V − V₀)² / (2 α V₀)` (a tetrahedron's or a
 //! particle's dual cell's volume) with `α` the constraints' compliance per unit volume (1/Pa). Tools and organ–organ contacts are not part of it.
+//!
+//! The schemes and the volume-constraint flag are those the body's elastic constants were
+//! derived under (`Derived::from`, the world's settings): the public functions here are given
+//! only a body, and the stiffness must be that of the constants it holds.
 
 use crate::body::Body;
+use crate::elastic::ElasticModel;
 use crate::error::Error;
 use crate::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
 use crate::settings::{ElasticScheme, VolumeScheme};
@@ -85,7 +90,7 @@ impl BlockMatrix {
 pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     let nbr = &body.model.nbr;
     let n = body.particle_count();
-    let tetrahedra = body.elastic_scheme == ElasticScheme::Tetrahedra;
+    let tetrahedra = body.derived.from.elastic.elastic_scheme == ElasticScheme::Tetrahedra;
     // Stencil of particle i: itself, then its neighbours; or of a tetrahedron, its corners.
     let stencils: Vec<Vec<u32>> = if tetrahedra {
         body.model.tets.iter().map(|t| t.to_vec()).collect()
@@ -117,7 +122,12 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
             .map(Vec::as_slice)
             .chain(volume_stencils.iter().map(Vec::as_slice)),
     );
-    let (lambda, mu, hourglass) = (body.elastic.lambda, body.elastic.mu, body.elastic.hourglass);
+    let ElasticModel {
+        lambda,
+        mu,
+        hourglass,
+        ..
+    } = body.derived.elastic;
     // The rotation of an element (a particle or a tetrahedron) at `at`, from its deformation
     // gradient there.
     let polar = |f: Mat3| {
@@ -201,7 +211,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
 fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &[(u32, Vec3)])) {
     let model = &body.model;
     let mut gradient = Vec::new();
-    match body.volume_scheme {
+    match body.derived.from.elastic.volume_scheme {
         VolumeScheme::Tetrahedra => {
             for (t, tet) in model.tets.iter().enumerate() {
                 gradient.clear();
@@ -238,8 +248,8 @@ fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &
 /// Stiffness per unit volume (Pa) of the volume constraints, `1/α`; 0 when they are off or
 /// infinitely compliant.
 fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
-    let alpha = body.volume_compliance;
-    if body.volume_constraints_on && alpha.is_finite() && alpha > 0.0 {
+    let alpha = body.derived.volume_compliance;
+    if body.derived.from.elastic.volume_constraints && alpha.is_finite() && alpha > 0.0 {
         1.0 / alpha
     } else {
         0.0
@@ -250,12 +260,12 @@ fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
 /// terms, and the weight's potential `−Σ m g·x`, at positions `x` (m).
 fn energy(body: &Body, x: &[Vec3], g: Vec3) -> Real {
     let model = &body.model;
-    let mut e = match body.elastic_scheme {
+    let mut e = match body.derived.from.elastic.elastic_scheme {
         ElasticScheme::PointBased => {
-            crate::elastic::energy(&body.elastic, &model.nbr, &model.particle_volume, x)
+            crate::elastic::energy(&body.derived.elastic, &model.nbr, &model.particle_volume, x)
         }
         ElasticScheme::Tetrahedra => {
-            crate::tet_elasticity::energy(&body.elastic, &model.tet_elements, x)
+            crate::tet_elasticity::energy(&body.derived.elastic, &model.tet_elements, x)
         }
     };
     let stiffness = volume_stiffness_per_unit_volume(body);

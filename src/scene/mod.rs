@@ -174,7 +174,7 @@ impl Scene {
         let mut h_max = Real::INFINITY;
         let mut radius = Real::INFINITY;
         for b in &self.bodies {
-            let w = b.omega_max;
+            let w = b.derived.omega_max;
             if w > 0.0 {
                 // Symplectic Euler with stiffness-proportional damping ξ = βω/2.
                 let xi = 0.5 * s.damping_stiffness * w;

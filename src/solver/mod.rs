@@ -235,7 +235,15 @@ impl Pipeline {
         let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
         let scratch = &mut self.workspace.bodies;
         for (body, scratch) in scene.bodies.iter_mut().zip(scratch.iter_mut()) {
-            predict::predict(body, scratch, gravity, h, alpha_damp, &self.pool);
+            predict::predict(
+                body,
+                s.elastic_scheme,
+                scratch,
+                gravity,
+                h,
+                alpha_damp,
+                &self.pool,
+            );
         }
         let organ_contact = scene.bodies.len() > 1;
         if organ_contact {
@@ -271,7 +279,7 @@ impl Pipeline {
         for it in 0..scene.settings.iterations {
             if scene.settings.volume_constraints {
                 for (body, scratch) in scene.bodies.iter().zip(scratch.iter_mut()) {
-                    match body.volume_scheme {
+                    match scene.settings.volume_scheme {
                         VolumeScheme::Tetrahedra => {
                             volume::project_volumes(body, scratch, h, &self.pool)
                         }

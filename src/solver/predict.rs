@@ -9,9 +9,11 @@ use crate::solver::StepScratch;
 use crate::tet_elasticity::{self, TetForceInputs};
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s): velocities into
-/// the body's state, forces and predicted positions into its `scratch`.
+/// the body's state, forces and predicted positions into its `scratch`; the elastic forces of
+/// the world's `scheme`.
 pub(crate) fn predict(
     body: &mut Body,
+    scheme: ElasticScheme,
     scratch: &mut StepScratch,
     gravity: Vec3,
     h: Real,
@@ -39,7 +41,7 @@ pub(crate) fn predict(
         }
         lambda.fill(0.0);
     });
-    match body.elastic_scheme {
+    match scheme {
         ElasticScheme::PointBased => {
             let input = ForceInputs {
                 nbr: &body.model.nbr,
@@ -49,7 +51,7 @@ pub(crate) fn predict(
                 active_before: &body.active_before,
             };
             accumulate_forces(
-                &body.elastic,
+                &body.derived.elastic,
                 &input,
                 &mut body.state.rotation,
                 ROTATION_ITERATIONS,
@@ -60,7 +62,7 @@ pub(crate) fn predict(
             );
         }
         ElasticScheme::Tetrahedra => tet_elasticity::accumulate_forces(
-            &body.elastic,
+            &body.derived.elastic,
             &TetForceInputs {
                 elements: &body.model.tet_elements,
                 x: &body.state.x,

@@ -25,10 +25,10 @@ const INTERLEAVED_BLOCKS: usize = LANES;
 /// on its predicted positions in `scratch`. Each constraint's XPBD compliance is the body's
 /// compliance per unit volume (1/Pa) times the tetrahedron's rest volume (m³), divided by h².
 pub(crate) fn project_volumes(body: &Body, scratch: &mut StepScratch, h: Real, pool: &Pool) {
-    if !body.volume_compliance.is_finite() {
+    if !body.derived.volume_compliance.is_finite() {
         return;
     }
-    let compliance_per_h2 = body.volume_compliance / (h * h);
+    let compliance_per_h2 = body.derived.volume_compliance / (h * h);
     let model = &body.model;
     let colouring = &model.tet_colouring;
     let p = SharedSlice::new(&mut scratch.p);
@@ -148,10 +148,10 @@ const MIN_PARALLEL_CELLS: usize = 1024;
 /// m³) has the XPBD compliance of the body's compliance per unit volume (1/Pa) times `V_i⁰`,
 /// divided by h²; its correction moves every particle of the cell's tetrahedra.
 pub(crate) fn project_dual_cells(body: &Body, scratch: &mut StepScratch, h: Real, pool: &Pool) {
-    if !body.volume_compliance.is_finite() {
+    if !body.derived.volume_compliance.is_finite() {
         return;
     }
-    let compliance_per_h2 = body.volume_compliance / (h * h);
+    let compliance_per_h2 = body.derived.volume_compliance / (h * h);
     let cells = &body.model.dual_cells;
     let order = cells.projection_order();
     let star = cells.max_star();

@@ -67,7 +67,7 @@ impl StepScratch {
             p: &mut self.p,
             x: &body.state.x,
             inv_mass: &body.inv_mass,
-            mass: &body.inertial_mass,
+            mass: &body.derived.inertial_mass,
             radius: body.model.particle_radius,
             youngs_modulus: body.model.options.material.youngs_modulus,
         }

@@ -7,10 +7,11 @@
 mod saved_state;
 mod state;
 
-use crate::body::{Body, BodyOptions};
-use crate::body_model::BodyModel;
+use crate::body::Body;
+use crate::body_model::{BodyModel, BodyOptions};
 use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
+use crate::derived::DerivedFrom;
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
 use crate::math::{is_finite_vec, Real, Vec3};
@@ -56,23 +57,12 @@ impl World {
     /// Replace the settings (validated; the world is unchanged on error).
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), Error> {
         settings.validate()?;
-        let s = &self.scene.settings;
-        let bodies_affected = settings.hourglass_stiffness != s.hourglass_stiffness
-            || settings.volume_constraints != s.volume_constraints
-            || settings.volumetric_split != s.volumetric_split
-            || settings.volume_scheme != s.volume_scheme
-            || settings.elastic_scheme != s.elastic_scheme
-            || settings.volume_compliance != s.volume_compliance
-            || settings.damping_stiffness != s.damping_stiffness
-            || settings.mass_scaling != s.mass_scaling
-            || settings.dt != s.dt
-            || settings.min_substeps != s.min_substeps
-            || settings.stability_margin != s.stability_margin;
-        if bodies_affected {
-            for b in &mut self.scene.bodies {
-                b.configure(&settings);
-            }
+        // Each body re-derives what depends on the settings iff that part of them changed.
+        let from = DerivedFrom::settings(&settings);
+        for b in &mut self.scene.bodies {
+            b.rederive(from);
         }
+        let s = &self.scene.settings;
         if settings.threads != s.threads {
             self.pipeline
                 .set_threads(settings.threads, &self.scene.bodies);
@@ -100,7 +90,8 @@ impl World {
     pub fn add_body_model(&mut self, model: Arc<BodyModel>) -> BodyId {
         self.pipeline.add_body(&model);
         let scene = &mut self.scene;
-        scene.bodies.push(Body::from_model(model, &scene.settings));
+        let from = DerivedFrom::settings(&scene.settings);
+        scene.bodies.push(Body::from_model(model, from));
         BodyId(scene.bodies.len() as u32 - 1)
     }
     /// Number of bodies.
@@ -504,7 +495,7 @@ impl World {
                 break;
             }
             let kinetic: Real = (self.scene.bodies.iter())
-                .flat_map(|b| b.state.v.iter().zip(&b.inertial_mass))
+                .flat_map(|b| b.state.v.iter().zip(&b.derived.inertial_mass))
                 .map(|(v, m)| m * v.norm_squared())
                 .sum();
             if kinetic < previous {
