@@ -287,7 +287,7 @@ impl Pipeline {
                             volume::project_dual_cells(body, scratch, h, &self.pool)
                         }
                     }
-                    if body.elastic_scheme == ElasticScheme::Tetrahedra {
+                    if scene.settings.elastic_scheme == ElasticScheme::Tetrahedra {
                         volume::project_crushed_tets(body, scratch);
                     }
                 }
