@@ -8,11 +8,11 @@
 
 use crate::body_model::{BodyModel, Material};
 use crate::derived::{Derived, DerivedFrom};
-use crate::elastic::{self, ElasticModel};
-use crate::lanes::{F4, LANES, V4};
-use crate::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
-use crate::neighbours::Neighbourhoods;
-use crate::parallel::{Pool, SharedSlice};
+use crate::kernels::point_elasticity::{self, ElasticModel};
+use crate::kernels::lanes::{F4, LANES, V4};
+use crate::kernels::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
+use crate::kernels::neighbours::Neighbourhoods;
+use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::particle_order::ParticleOrder;
 use std::sync::Arc;
 
@@ -110,7 +110,7 @@ pub struct Body {
     /// `active_before[i]`: how many of the particles before `i` are not inert (length:
     /// particles + 1). An inert particle is fixed, and so is every one of its neighbours: its
     /// elastic terms act only on fixed particles, whose forces a step does not use, so the
-    /// step's force pass skips it (`elastic::ForceInputs::active_before`). Follows the fixed
+    /// step's force pass skips it (`point_elasticity::ForceInputs::active_before`). Follows the fixed
     /// flags ([`Body::fixed_flags_changed`]).
     pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
@@ -237,7 +237,7 @@ impl Body {
     /// winding number about the point is above one half). Cost: one pass over the boundary
     /// triangles.
     pub fn contains(&self, point: &Vec3) -> bool {
-        crate::collision::winding::inside_surface(point, &self.state.x, &self.model.boundary)
+        crate::kernels::collision::winding::inside_surface(point, &self.state.x, &self.model.boundary)
     }
     /// Current volume (m³): the sum of the signed tetrahedron volumes, computed as the volume
     /// the boundary surface encloses (the same sum: the inner faces cancel), a pass over the
@@ -296,7 +296,7 @@ impl Body {
 
     /// Deformation gradient of particle `i` if the particles were at `positions` (m).
     pub fn deformation_gradient_at(&self, positions: &[Vec3], i: usize) -> Mat3 {
-        elastic::deformation_gradient(&self.model.nbr, positions, i)
+        point_elasticity::deformation_gradient(&self.model.nbr, positions, i)
     }
 
     /// Elastic (and hourglass) forces (N) on every particle if the particles were at
@@ -331,7 +331,7 @@ impl Body {
     /// inert particles depend on the fixed flags alone.
     pub(crate) fn fixed_flags_changed(&mut self) {
         self.update_inverse_masses();
-        elastic::count_active(&self.model.nbr, &self.fixed, &mut self.active_before);
+        point_elasticity::count_active(&self.model.nbr, &self.fixed, &mut self.active_before);
     }
 }
 

@@ -5,7 +5,7 @@
 //! Notation: particle `i` with volume `v_i` (m³) and neighbours `j ∈ N(i)`; the rest offsets
 //! `u_ij` are the rows of `U_i` (`k_i × 3`) and the gradient coefficients `g_ij` (1/m) the rows
 //! of `G_i`, so that `∇ψ_j(X_i) = g_ij` and `∇ψ_i(X_i) = −Σ_j g_ij` (the deformation gradient
-//! `F_i = I + Σ_j (x_ij − u_ij) g_ijᵀ` of [`crate::elastic`]).
+//! `F_i = I + Σ_j (x_ij − u_ij) g_ijᵀ` of [`crate::kernels::point_elasticity`]).
 //!
 //! - Linear consistency (kept): `G_iᵀ U_i = I`, so an affine motion gives exactly its `F`.
 //! - Integration constraint (imposed): for every particle `l`,
@@ -22,8 +22,8 @@
 //! `Σ_i v_i` is the mesh volume. It is solved matrix-free by Jacobi-preconditioned conjugate
 //! gradients, once at load time; the step's cost does not change.
 
-use crate::math::{Mat3, Real, Vec3};
-use crate::neighbours::Neighbourhoods;
+use crate::kernels::math::{Mat3, Real, Vec3};
+use crate::kernels::neighbours::Neighbourhoods;
 
 /// Largest number of conjugate-gradient iterations of the correction.
 const MAX_ITERATIONS: usize = 20_000;

@@ -23,13 +23,13 @@
 
 use crate::body::Body;
 use crate::body_model::BodyModel;
-use crate::colouring::TetColouring;
+use crate::kernels::colouring::TetColouring;
 use crate::derived::StabilityBase;
 use crate::dual_cells::DualCells;
-use crate::math::{Mat3, Real, Vec3};
+use crate::kernels::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
-use crate::neighbours::Neighbourhoods;
-use crate::tet_elasticity::TetElements;
+use crate::kernels::neighbours::Neighbourhoods;
+use crate::kernels::tet_elasticity::TetElements;
 use std::sync::Arc;
 
 /// A blade's edge at the start and at the end of its motion over one step (m, world frame).

@@ -24,12 +24,12 @@
 //! settings the body was derived under, which are the world's.
 
 use crate::body_model::BodyModel;
-use crate::elastic::{self, ElasticModel, ForceInputs};
-use crate::math::{Quat, Real, Vec3};
-use crate::parallel::Pool;
+use crate::kernels::point_elasticity::{self as elastic, ElasticModel, ForceInputs};
+use crate::kernels::math::{Quat, Real, Vec3};
+use crate::kernels::parallel::Pool;
 use crate::settings::{ElasticScheme, Settings, VolumeScheme};
-use crate::stability;
-use crate::tet_elasticity::{self, TetForceInputs};
+use crate::kernels::stability;
+use crate::kernels::tet_elasticity::{self, TetForceInputs};
 
 /// The settings a body's elastic constants and volume compliance derive from (the fields of
 /// [`Settings`] of the same names).

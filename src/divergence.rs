@@ -9,7 +9,7 @@
 //! those steps brings it closer.
 
 use crate::body::{volume_of, Body};
-use crate::math::{is_finite_vec, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::settings::DivergenceLimits;
 
 /// The particle half of the check over a run of particles: the first particle that is

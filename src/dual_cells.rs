@@ -5,7 +5,7 @@
 //! does not lock as ν → 0.5 (the average nodal pressure tetrahedron of Bonet & Burton 1998,
 //! solved as XPBD constraints).
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// For the tetrahedron corner at position `c` (0..4) of its four, the other three corners in an
 /// order that, put after it, is an even permutation of the four: the tetrahedron's volume is
@@ -234,7 +234,7 @@ impl DualCells {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::tet_volume;
+    use crate::kernels::math::tet_volume;
     use crate::mesh::lattice_box;
 
     /// Two tetrahedra sharing a face; the cells' volumes sum to the mesh's, and each gradient

@@ -14,9 +14,9 @@
 //! [`World::release`](crate::World::release) lets go and contact acts again.
 
 use crate::body::Body;
-use crate::collision::tool::{Pose, Tool, ToolLoad};
+use crate::scene::tool::{Pose, Tool, ToolLoad};
 use crate::error::{check_finite, Error};
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use crate::particles::ParticleViews;
 use parry3d_f64::math::Point;
 

@@ -26,40 +26,28 @@
 
 pub(crate) mod body;
 pub(crate) mod body_model;
-pub(crate) mod collision;
-pub(crate) mod colouring;
 pub(crate) mod consistency;
-pub(crate) mod constraints;
 pub mod cut;
 pub(crate) mod derived;
 pub(crate) mod divergence;
 pub(crate) mod dual_cells;
-pub(crate) mod elastic;
 pub(crate) mod error;
 pub mod ffi;
+pub(crate) mod kernels;
 pub mod grasp;
-pub(crate) mod lanes;
-pub(crate) mod math;
 pub mod mesh;
 pub mod needle;
-pub(crate) mod neighbours;
-pub(crate) mod pair_sums;
-pub(crate) mod parallel;
 pub(crate) mod particle_order;
 pub(crate) mod particles;
 pub mod render;
-pub(crate) mod rotation;
 pub(crate) mod scene;
 pub(crate) mod settings;
 pub(crate) mod solver;
-pub(crate) mod stability;
 // The saved-state byte format: public as `tissuesim::state`, in a file whose name says what it
 // holds (the state as a value is `scene::state`).
 #[path = "saved_state.rs"]
 pub mod state;
 pub mod statics;
-pub(crate) mod tet_elasticity;
-pub(crate) mod vec3_array;
 pub(crate) mod world;
 
 pub use body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
@@ -67,16 +55,16 @@ pub use body_model::{
     BodyModel, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
     PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
 };
-pub use collision::tool::{
+pub use scene::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,
 };
 pub use cut::{Blade, CutReport};
 pub use error::Error;
 pub use grasp::GraspOptions;
-pub use math::{tet_volume, Mat3, Quat, Real, Vec3};
+pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use needle::{NeedleOptions, NeedleState};
-pub use neighbours::MAX_NEIGHBOURS;
+pub use kernels::neighbours::MAX_NEIGHBOURS;
 pub use particle_order::ParticleOrder;
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
 pub use settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};

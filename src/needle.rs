@@ -23,9 +23,9 @@
 //! out and contact acts again.
 
 use crate::body::Body;
-use crate::collision::tool::{Pose, Tool, ToolLoad, ToolShape};
+use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use crate::error::{check_finite, Error};
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use crate::particles::ParticleViews;
 use parry3d_f64::math::Point;
 

@@ -14,7 +14,7 @@
 //! messages. The Rust API of [`Body`](crate::Body) and [`BodyModel`](crate::BodyModel) works in
 //! particle order (so its slices are views, not copies), and [`ParticleOrder`] converts.
 
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 use crate::mesh::TetMesh;
 
 /// A permutation between a mesh's node indices and a body's particle indices.

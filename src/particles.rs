@@ -5,7 +5,7 @@
 //! ([`ParticleViews`]) from what it owns; the constants the interactions share with the scene
 //! live here too, below both.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// Thickness of the contact skin over the boundary surface, in particle radii: contact starts
 /// this far out (0.6 mm on the default organ), so that a tool resting on the surface stays in

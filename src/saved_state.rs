@@ -33,10 +33,10 @@
 //! [`World::set_state`]: crate::World::set_state
 
 use crate::body::ParticleState;
-use crate::collision::tool::{Pose, Wrench};
+use crate::scene::tool::{Pose, Wrench};
 use crate::error::Error;
 use crate::grasp::{Attachment, Grasp};
-use crate::math::{Quat, Real, Vec3};
+use crate::kernels::math::{Quat, Real, Vec3};
 use crate::needle::ShaftHold;
 use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use std::sync::Arc;

@@ -1,7 +1,7 @@
 //! The world's settings: one plain struct, every field in SI units, with a [`Default`] suited to
 //! an organ of ~0.2 m stepped at 1 kHz.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// The most threads a world's step runs on ([`Settings::threads`]).
 pub(crate) const MAX_THREADS: usize = 64;
@@ -25,10 +25,10 @@ pub enum ContactMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ElasticScheme {
     /// The paper's point-based elasticity: a moving-least-squares deformation gradient per
-    /// particle, nodal integration with hourglass control (`crate::elastic`). The default.
+    /// particle, nodal integration with hourglass control (`crate::kernels::point_elasticity`). The default.
     PointBased,
     /// Corotated linear tetrahedra: one deformation gradient and rotation per tetrahedron of
-    /// the mesh, the same corotated stress (`crate::tet_elasticity`); no zero-energy modes, so
+    /// the mesh, the same corotated stress (`crate::kernels::tet_elasticity`); no zero-energy modes, so
     /// no hourglass control. The particles stay the unknowns; contact, volume constraints and
     /// everything else are unchanged. With the volume constraints on, a crush guard keeps every
     /// tetrahedron above a tenth of its rest volume (a hard one-sided constraint, inactive
@@ -87,7 +87,7 @@ pub struct Settings {
     pub damping_stiffness: Real,
     /// Hourglass-control stiffness (dimensionless, multiplies the shear modulus μ): penalises
     /// the part of each pair's deformation that the particle's deformation gradient does not
-    /// explain (in the spirit of Ganzenmüller 2015; the form in `crate::elastic`), which suppresses the zero-energy modes of nodal
+    /// explain (in the spirit of Ganzenmüller 2015; the form in `crate::kernels::point_elasticity`), which suppresses the zero-energy modes of nodal
     /// integration. Zero for every affine motion, so it never affects the patch test. The
     /// default 0.25 comes from the static study of docs/VALIDATION.md: with the volume
     /// constraints on, the worst error against FEM over two livers and a beam is flat for

@@ -21,9 +21,9 @@
 //! only a body, and the stiffness must be that of the constants it holds.
 
 use crate::body::Body;
-use crate::elastic::ElasticModel;
+use crate::kernels::point_elasticity::ElasticModel;
 use crate::error::Error;
-use crate::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
+use crate::kernels::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
 use crate::settings::{ElasticScheme, VolumeScheme};
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
@@ -131,7 +131,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     // The rotation of an element (a particle or a tetrahedron) at `at`, from its deformation
     // gradient there.
     let polar = |f: Mat3| {
-        crate::rotation::rotation_from_svd(&f)
+        crate::kernels::rotation::rotation_from_svd(&f)
             .to_rotation_matrix()
             .into_inner()
     };
@@ -164,7 +164,7 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     for (i, stencil) in particles.iter().enumerate() {
         let vi = body.model.particle_volume[i];
         let r = at.map_or(Mat3::identity(), |x| {
-            polar(crate::elastic::deformation_gradient(nbr, x, i))
+            polar(crate::kernels::point_elasticity::deformation_gradient(nbr, x, i))
         });
         let range = nbr.range(i);
         // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
@@ -262,10 +262,10 @@ fn energy(body: &Body, x: &[Vec3], g: Vec3) -> Real {
     let model = &body.model;
     let mut e = match body.derived.from.elastic.elastic_scheme {
         ElasticScheme::PointBased => {
-            crate::elastic::energy(&body.derived.elastic, &model.nbr, &model.particle_volume, x)
+            crate::kernels::point_elasticity::energy(&body.derived.elastic, &model.nbr, &model.particle_volume, x)
         }
         ElasticScheme::Tetrahedra => {
-            crate::tet_elasticity::energy(&body.derived.elastic, &model.tet_elements, x)
+            crate::kernels::tet_elasticity::energy(&body.derived.elastic, &model.tet_elements, x)
         }
     };
     let stiffness = volume_stiffness_per_unit_volume(body);
@@ -702,8 +702,8 @@ pub(crate) fn settle_body(body: &mut Body, g: Vec3) -> Result<StaticSolve, Error
     body.state.x.copy_from_slice(&x);
     body.state.v.iter_mut().for_each(|v| *v = Vec3::zeros());
     for i in 0..x.len() {
-        let f = crate::elastic::deformation_gradient(&body.model.nbr, &x, i);
-        body.state.rotation[i] = crate::rotation::rotation_from_svd(&f);
+        let f = crate::kernels::point_elasticity::deformation_gradient(&body.model.nbr, &x, i);
+        body.state.rotation[i] = crate::kernels::rotation::rotation_from_svd(&f);
     }
     Ok(StaticSolve {
         iterations,

@@ -7,7 +7,7 @@
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 
 /// `TS_STATUS_NULL_PARAMETER` when `p` is NULL.
 pub fn non_null<T>(p: *const T, name: &str) -> FfiResult {

@@ -10,7 +10,7 @@ use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 use crate::mesh::{self, TetMesh};
 use crate::scene::BodyId;
 use std::ffi::{c_char, CStr};

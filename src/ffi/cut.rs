@@ -6,7 +6,7 @@ use crate::ffi::args::{all_finite, input_slice, non_null, world_mut, world_ref, 
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 use crate::scene::{BodyId, ToolId};
 
 /// What a cut removed.

@@ -7,7 +7,7 @@ use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 use crate::render::{read_obj, RenderMesh, RenderSurface};
 use crate::scene::BodyId;
 use crate::world::RenderSurfaceId;

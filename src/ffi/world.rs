@@ -5,7 +5,7 @@ use crate::ffi::args::{non_null, world_mut, world_ref, write};
 use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 use crate::settings::{ContactMode, DivergenceLimits, Settings};
 use crate::world::World;
 

@@ -2,7 +2,7 @@
 //! tetrahedron, oriented with their normal pointing out of the solid.
 
 use super::TetMesh;
-use crate::math::tet_volume;
+use crate::kernels::math::tet_volume;
 
 /// The four faces of a positively oriented tetrahedron `[a, b, c, d]`, as local indices, each
 /// ordered so that its normal `(v1-v0)×(v2-v0)` points away from the opposite node.
@@ -66,7 +66,7 @@ pub(crate) fn boundary_vertices(boundary: &[[u32; 3]]) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
+    use crate::kernels::math::Vec3;
 
     #[test]
     fn outward_faces_point_away_from_opposite_node() {

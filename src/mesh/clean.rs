@@ -3,7 +3,7 @@
 //! and of unreferenced nodes.
 
 use super::{MeshError, MeshReport, TetMesh};
-use crate::math::{is_finite_vec, tet_volume, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
 use std::path::Path;
 
 /// A tetrahedron whose |volume| is at most this fraction of the mean |volume| is degenerate.

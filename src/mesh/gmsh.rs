@@ -4,7 +4,7 @@
 
 use super::parse::{prealloc, read_text, Line, Lines};
 use super::{MeshError, MeshReport, TetMesh};
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! neighbouring cells match).
 
 use super::TetMesh;
-use crate::math::{tet_volume, Vec3};
+use crate::kernels::math::{tet_volume, Vec3};
 
 /// The six Kuhn tetrahedra of a unit cell, as corner indices `i + 2j + 4k` for the corner at
 /// `(i, j, k) ∈ {0,1}³`. Each walks from corner 0 to corner 7 along the three axes in one of the

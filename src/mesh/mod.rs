@@ -5,7 +5,7 @@
 //! Every mesh goes through [`TetMesh::from_raw`], which re-orients inverted tetrahedra, removes
 //! degenerate ones and unreferenced nodes, and reports what it did in a [`MeshReport`].
 
-use crate::math::{tet_volume, Real, Vec3};
+use crate::kernels::math::{tet_volume, Real, Vec3};
 use std::fmt;
 use std::path::{Path, PathBuf};
 

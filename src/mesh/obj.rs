@@ -3,7 +3,7 @@
 
 use super::parse::{read_text, Lines};
 use super::{MeshError, SurfaceMesh};
-use crate::math::Real;
+use crate::kernels::math::Real;
 use std::path::Path;
 
 /// Read an OBJ surface, positions multiplied by `scale`.

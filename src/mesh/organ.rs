@@ -6,7 +6,7 @@
 
 use super::lattice::KUHN_TETS;
 use super::TetMesh;
-use crate::math::{tet_volume, Real, Vec3};
+use crate::kernels::math::{tet_volume, Real, Vec3};
 use std::path::Path;
 
 /// Edge length of the lattice cells of the default organ (m).

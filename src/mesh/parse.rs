@@ -3,7 +3,7 @@
 //! numbers into [`MeshError`]s that name the file and the line.
 
 use super::MeshError;
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use std::path::Path;
 use std::str::FromStr;
 

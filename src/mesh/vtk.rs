@@ -4,7 +4,7 @@
 
 use super::parse::{prealloc, read_text, Tokens};
 use super::{MeshError, MeshReport, TetMesh};
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use std::io::Write;
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! VTU writer: XML `UnstructuredGrid`, ASCII, for ParaView: tetrahedra (cell type 10) or
 //! triangles (cell type 5, surfaces).
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use std::io::{self, Write};
 use std::path::Path;
 

@@ -8,7 +8,7 @@
 //! linear in the number of tetrahedra and each query touches a bounded number of cells for
 //! points near the mesh: binding n points is near-linear, never O(n · tets).
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use parry3d_f64::math::Point;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Tetrahedron;
@@ -55,7 +55,7 @@ pub struct BindReport {
 /// Barycentric coordinates of `p` in the tetrahedron `(a, b, c, d)`, or `None` when it is
 /// degenerate.
 fn barycentric(p: &Vec3, [a, b, c, d]: [Vec3; 4]) -> Option<[Real; 4]> {
-    let m = crate::math::Mat3::from_columns(&[b - a, c - a, d - a]);
+    let m = crate::kernels::math::Mat3::from_columns(&[b - a, c - a, d - a]);
     let l = m.try_inverse()? * (p - a);
     Some([1.0 - l.x - l.y - l.z, l.x, l.y, l.z])
 }

@@ -2,7 +2,7 @@
 //! combination of position, texture coordinate and normal.
 
 use crate::error::Error;
-use crate::math::{is_finite_vec, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use std::collections::HashMap;
 
 /// Where a render vertex came from: 0-based indices of its OBJ `v`, `vt` and `vn` records.

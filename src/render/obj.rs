@@ -3,7 +3,7 @@
 //! Other records (`g`, `s`, `usemtl`, ...) are ignored. Errors name the file and the line.
 
 use super::mesh::{ObjVertex, RenderMesh};
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use crate::mesh::parse::{check_scale, read_text, Line, Lines};
 use crate::mesh::MeshError;
 use std::collections::HashMap;

@@ -5,7 +5,7 @@ use super::bind::{bind, BindReport, Binding};
 use super::mesh::RenderMesh;
 use crate::body::Body;
 use crate::error::Error;
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use crate::scene::BodyId;
 use std::path::Path;
 

@@ -7,15 +7,16 @@
 //! dynamic state as one value, [`WorldState`], is in [`state`].
 
 pub(crate) mod state;
+pub(crate) mod tool;
 
 pub use state::WorldState;
 
 use crate::body::Body;
-use crate::collision::tool::{Tool, ToolLoad};
+use crate::scene::tool::{Tool, ToolLoad};
 use crate::cut::CutReport;
 use crate::error::Error;
 use crate::grasp::Grasp;
-use crate::math::Real;
+use crate::kernels::math::Real;
 use crate::needle::Needle;
 use crate::settings::Settings;
 

@@ -14,13 +14,13 @@
 //! [`World::set_state`]: crate::World::set_state
 
 use crate::body::{Body, ParticleState};
-use crate::collision::tool::{Pose, Wrench};
+use crate::scene::tool::{Pose, Wrench};
 use crate::cut::CutSets;
 use crate::error::Error;
 use crate::grasp::Grasp;
-use crate::math::{is_finite_vec, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::needle::ShaftHold;
-use crate::parallel::Pool;
+use crate::kernels::parallel::Pool;
 use crate::scene::Scene;
 use std::sync::Arc;
 

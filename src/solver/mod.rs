@@ -46,12 +46,12 @@ pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::body::{volume_on, Body};
 use crate::body_model::BodyModel;
-use crate::collision::tool::{Pose, ToolShape, Wrench};
+use crate::scene::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
 use crate::error::Error;
-use crate::math::{Real, Vec3};
-use crate::parallel::{Pool, SharedSlice};
+use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::particles::{ParticleView, ParticleViews};
 use crate::scene::{Scene, StepReport, ToolSlot};
 use crate::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};

@@ -3,10 +3,10 @@
 //! `crate::solver::surface_self_contact`.)
 
 use crate::body::Body;
-use crate::collision::hash_grid::HashGrid;
-use crate::constraints::contact::project_particle_particle;
-use crate::constraints::friction::friction_correction;
-use crate::math::{Real, Vec3};
+use crate::kernels::collision::hash_grid::HashGrid;
+use crate::kernels::constraints::contact::project_particle_particle;
+use crate::kernels::constraints::friction::friction_correction;
+use crate::kernels::math::{Real, Vec3};
 use crate::scene::PairFriction;
 use crate::solver::StepScratch;
 

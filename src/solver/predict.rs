@@ -1,12 +1,12 @@
 //! Forces and the symplectic prediction of a body for one substep.
 
 use crate::body::{Body, ROTATION_ITERATIONS};
-use crate::elastic::{accumulate_forces, ForceInputs};
-use crate::math::{Real, Vec3};
-use crate::parallel::{Pool, SharedSlice};
+use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
+use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::settings::ElasticScheme;
 use crate::solver::StepScratch;
-use crate::tet_elasticity::{self, TetForceInputs};
+use crate::kernels::tet_elasticity::{self, TetForceInputs};
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s): velocities into
 /// the body's state, forces and predicted positions into its `scratch`; the elastic forces of

@@ -8,10 +8,10 @@
 //! meets the samples only once it is out: the samples alone would push it out of each sample
 //! separately, in directions that fight, and a particle deep inside meets none of them.
 
-use crate::collision::tool::{Pose, Tool, ToolLoad};
-use crate::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
-use crate::constraints::friction::friction_correction;
-use crate::math::{Real, Vec3};
+use crate::scene::tool::{Pose, Tool, ToolLoad};
+use crate::kernels::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
+use crate::kernels::constraints::friction::friction_correction;
+use crate::kernels::math::{Real, Vec3};
 use crate::particles::ParticleView;
 use crate::solver::tool_motion_at;
 use parry3d_f64::math::Point;

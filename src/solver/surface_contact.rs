@@ -30,10 +30,10 @@
 //!   far side, on the line along `n` through the foot of the tool's middle, is `r` in front of it;
 //! - otherwise (a tool inside the body, e.g. after a teleport) the minimal separation.
 
-use crate::collision::tool::{Pose, Tool, ToolLoad, ToolShape};
-use crate::constraints::friction::friction_correction;
-use crate::math::{Real, Vec3};
-use crate::parallel::{Pool, SharedSlice};
+use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
+use crate::kernels::constraints::friction::friction_correction;
+use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::particles::{ParticleView, SURFACE_SKIN};
 use crate::solver::tool_motion_at;
 use parry3d_f64::math::{Isometry, Point};

@@ -55,9 +55,9 @@
 
 use crate::body::Body;
 use crate::body_model::BodyModel;
-use crate::collision::triangle_grid::TriangleGrid;
-use crate::constraints::friction::friction_correction;
-use crate::math::{Real, Vec3};
+use crate::kernels::collision::triangle_grid::TriangleGrid;
+use crate::kernels::constraints::friction::friction_correction;
+use crate::kernels::math::{Real, Vec3};
 use crate::solver::surface_contact::MAX_CORNER_SHARE;
 use crate::solver::StepScratch;
 use parry3d_f64::math::Point;

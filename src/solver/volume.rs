@@ -1,5 +1,5 @@
 //! The XPBD tetrahedron volume constraints of a body, one Gauss–Seidel pass in colour order
-//! (`crate::colouring`): the colours in sequence, the blocks of a colour (which share no
+//! (`crate::kernels::colouring`): the colours in sequence, the blocks of a colour (which share no
 //! particle) split over the thread pool, each block's tetrahedra in their order, four blocks
 //! in lock-step, one a lane (`volume_tet_corrections4`). The blocks share no particle, so the
 //! result is that of projecting them one after the other, and it does not depend on the
@@ -7,10 +7,10 @@
 //! colour, their cells in place of the blocks.
 
 use crate::body::Body;
-use crate::constraints::volume::{volume_tet_correction, volume_tet_corrections4};
-use crate::lanes::{F4, LANES, V4};
-use crate::math::Real;
-use crate::parallel::{Barrier, Pool, SharedSlice};
+use crate::kernels::constraints::volume::{volume_tet_correction, volume_tet_corrections4};
+use crate::kernels::lanes::{F4, LANES, V4};
+use crate::kernels::math::Real;
+use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
 use crate::solver::StepScratch;
 use std::ops::Range;
 
@@ -243,7 +243,7 @@ pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) {
             let floor = CRUSH_FLOOR_RATIO * elements.volume(t);
             let mut lambda = 0.0;
             // The hard constraint `V = floor`, applied only below it.
-            if crate::math::tet_volume(&x[0], &x[1], &x[2], &x[3]) >= floor {
+            if crate::kernels::math::tet_volume(&x[0], &x[1], &x[2], &x[3]) >= floor {
                 continue;
             }
             if let Some(dp) = volume_tet_correction(x, w, floor, 0.0, &mut lambda) {

@@ -4,9 +4,9 @@
 
 use crate::body::Body;
 use crate::body_model::BodyModel;
-use crate::collision::hash_grid::HashGrid;
+use crate::kernels::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use crate::particles::ParticleView;
 use crate::scene::WorldState;
 use crate::solver::{SelfContactScratch, SurfaceScratch};
@@ -19,7 +19,7 @@ pub(crate) struct StepScratch {
     /// Forces of the current substep (N).
     pub(crate) force: Vec<Vec3>,
     /// Pair forces of the force pass (N) kept for the particles summed after its barrier
-    /// (`crate::pair_sums`), one entry per pair slot; empty on one thread, where nothing is
+    /// (`crate::kernels::pair_sums`), one entry per pair slot; empty on one thread, where nothing is
     /// kept.
     pub(crate) pair_force: Vec<Vec3>,
     /// The particles' sums of their pair forces (N), kept as `pair_force` is (one entry per

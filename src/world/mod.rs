@@ -9,12 +9,12 @@ mod state;
 
 use crate::body::Body;
 use crate::body_model::{BodyModel, BodyOptions};
-use crate::collision::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
+use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::derived::DerivedFrom;
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
-use crate::math::{is_finite_vec, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::needle::{Needle, NeedleOptions, NeedleState};
 use crate::render::{RenderMesh, RenderSurface};

@@ -4,9 +4,9 @@
 //!
 //! Per particle `i` with volume `v_i` (m³):
 //! 1. `F_i = I + Σ_j (x_ij - u_ij) d_ijᵀ` (= `Σ_j x_ij d_ijᵀ`, eq. 1–2, written in displacements
-//!    for round-off), see [`crate::neighbours`];
+//!    for round-off), see [`crate::kernels::neighbours`];
 //! 2. `R_i` = the rotation that maximises `tr(Rᵀ F_i)` over proper rotations, found four
-//!    particles at a time by warm-started Newton steps, see [`crate::rotation`]. This is
+//!    particles at a time by warm-started Newton steps, see [`crate::kernels::rotation`]. This is
 //!    `U diag(1, 1, det(UVᵀ)) Vᵀ` of the SVD `F = U Σ Vᵀ`: Irving et al.'s inversion handling
 //!    (one singular value negated when `F` is inverted);
 //! 3. first Piola–Kirchhoff stress of the corotated model (eq. 3, `P = U P̂ Vᵀ` with
@@ -26,12 +26,12 @@
 //! the pair's elastic stiffness (N/m): stiffness-proportional (Rayleigh β) damping that is
 //! central (momentum conserving) and zero under rigid motion.
 
-use crate::lanes::{F4, LANES, M4, V4};
-use crate::math::{Mat3, Quat, Real, Vec3};
-use crate::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
-use crate::pair_sums::{self, Kept, ShareForces};
-use crate::parallel::{Barrier, Pool, SharedSlice};
-use crate::rotation::{extract_rotations, rotation_from_svd};
+use crate::kernels::lanes::{F4, LANES, M4, V4};
+use crate::kernels::math::{Mat3, Quat, Real, Vec3};
+use crate::kernels::neighbours::{Neighbourhoods, MAX_FIXED_NEIGHBOURS};
+use crate::kernels::pair_sums::{self, Kept, ShareForces};
+use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
+use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 use std::ops::Range;
 
 /// The constants of the elastic model of one body.
@@ -116,7 +116,7 @@ pub struct ForceInputs<'a> {
 /// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). The particles are split into
 /// one contiguous share per thread; each share runs its particles in order and scatters each
 /// term to a particle all of whose terms come from the share, and keeps the others for a sum
-/// after a barrier, in the same order ([`crate::pair_sums`]). Every force is so summed in the
+/// after a barrier, in the same order ([`crate::kernels::pair_sums`]). Every force is so summed in the
 /// one-thread order: the result is bit-identical for any number of threads. Particles that
 /// [`ForceInputs::active_before`] leaves out are skipped, four at a time.
 #[allow(clippy::too_many_arguments)]
@@ -355,7 +355,7 @@ struct BlockBuffer {
 }
 
 /// Chunks of four pair slots a particle may have: the largest neighbourhood that
-/// [`crate::neighbours::build`] accepts, padded.
+/// [`crate::kernels::neighbours::build`] accepts, padded.
 const MAX_CHUNKS: usize = MAX_FIXED_NEIGHBOURS.div_ceil(LANES);
 
 impl BlockBuffer {
@@ -378,7 +378,7 @@ struct PairChunk {
 }
 
 /// The rest data of a particle's pair slots (a whole number of chunks, see
-/// [`crate::neighbours::PAIR_SLOT_ALIGNMENT`]), four slots a chunk.
+/// [`crate::kernels::neighbours::PAIR_SLOT_ALIGNMENT`]), four slots a chunk.
 struct PairChunks<'a> {
     /// Above every neighbour index of `j` (of the slots these were split from, for a
     /// [`PairChunks::sub`]): a field at least this long can be gathered from without a check
@@ -464,7 +464,7 @@ impl<'a> PairChunks<'a> {
 /// block's slots, from the first particle's; zero for the padding), and each particle's sum in
 /// `own`.
 ///
-/// Per particle, three passes over its slots, four at a time (see [`crate::lanes`]); the
+/// Per particle, three passes over its slots, four at a time (see [`crate::kernels::lanes`]); the
 /// rotations and stresses of the block's particles in lanes, one a lane. A padding slot
 /// (neighbour `i`, zero rest data) adds nothing anywhere. Always inlined, so that [`Kernel`]
 /// compiles it into its copies.
@@ -674,7 +674,7 @@ pub(crate) fn energy(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::neighbours::{build, SupportRadius};
+    use crate::kernels::neighbours::{build, SupportRadius};
 
     /// A jittered 5×4×4 block of points (m), with a deterministic pseudo-random jitter.
     fn jittered_block() -> Vec<Vec3> {

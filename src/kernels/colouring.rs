@@ -18,7 +18,7 @@
 //! Greedy first fit in block order: each block takes the first colour none of whose blocks
 //! touches its particles.
 
-use crate::math::Real;
+use crate::kernels::math::Real;
 
 /// Tetrahedra per block.
 pub(crate) const BLOCK: usize = 128;
@@ -162,8 +162,8 @@ impl TetColouring {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::tet_volume;
-    use crate::math::Vec3;
+    use crate::kernels::math::tet_volume;
+    use crate::kernels::math::Vec3;
     use crate::mesh::{lattice_box, TetMesh};
 
     fn volumes(mesh: &TetMesh) -> Vec<Real> {

@@ -5,7 +5,7 @@
 //! surface normal by the sample radius, so that the union of the sample spheres approximates the
 //! tool's own surface rather than a surface inflated by one radius.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 use parry3d_f64::math::Point;
 use parry3d_f64::shape::SharedShape;
 use std::f64::consts::PI;

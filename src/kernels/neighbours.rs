@@ -13,9 +13,9 @@
 //! partial last chunk. [`Neighbourhoods::range`] gives a particle's real pairs and
 //! [`Neighbourhoods::slots`] its padded run.
 
-use crate::lanes::LANES;
-use crate::math::{Mat3, Real, Vec3};
-use crate::vec3_array::Vec3Array;
+use crate::kernels::lanes::LANES;
+use crate::kernels::math::{Mat3, Real, Vec3};
+use crate::kernels::vec3_array::Vec3Array;
 
 /// Largest accepted condition number of a particle's moment matrix `A_i`; a particle above it
 /// gets a larger support radius (more neighbours) at load time.
@@ -65,7 +65,7 @@ pub struct Neighbourhoods {
     /// `sources[j]`: the first and the last of the particles whose pairs particle `j`'s force
     /// sum reads, the particles that have `j` as a neighbour and `j` itself (length:
     /// particles). A thread whose share of the particles holds them scatters `j`'s terms itself
-    /// ([`crate::pair_sums`]).
+    /// ([`crate::kernels::pair_sums`]).
     pub sources: Vec<[u32; 2]>,
     /// `reach[i]`: the first and the last of the sources of particle `i` and of its neighbours
     /// (length: particles). A share that holds them scatters every term of `i` itself, with no

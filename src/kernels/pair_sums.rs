@@ -15,8 +15,8 @@
 //! earlier version did, streamed the pair forces through memory on the large livers: on
 //! liver_31k ~15 MB written and read back a step, next to the ~37 MB of rest data.
 
-use crate::math::Vec3;
-use crate::neighbours::Neighbourhoods;
+use crate::kernels::math::Vec3;
+use crate::kernels::neighbours::Neighbourhoods;
 use std::ops::Range;
 
 /// Whether particle `j` has a source outside the particles `share`: its sum is then taken from
@@ -152,8 +152,8 @@ fn subtract_pairs(sums: &mut [Vec3; 2], lists: [&[u32]; 2], kept: Kept<'_>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Real;
-    use crate::neighbours::{build, SupportRadius};
+    use crate::kernels::math::Real;
+    use crate::kernels::neighbours::{build, SupportRadius};
 
     /// Shares of a lattice body, each handing on its particles' results in order: the forces
     /// after the barrier are exactly the bits of the one-thread scatter, in three shares (with

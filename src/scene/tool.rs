@@ -1,7 +1,7 @@
 //! Kinematic rigid instruments: their shape (a parry shape), pose, friction and contact wrench.
 
 use crate::error::{check_finite, Error};
-use crate::math::{is_finite_vec, Quat, Real, Vec3};
+use crate::kernels::math::{is_finite_vec, Quat, Real, Vec3};
 use parry3d_f64::math::{Isometry, Point, Translation};
 use parry3d_f64::shape::{SharedShape, TriMeshFlags};
 
@@ -372,7 +372,7 @@ impl Tool {
         let aabb = shape.compute_local_aabb();
         let bounding_radius = aabb.center().coords.norm() + aabb.half_extents().norm();
         let spacing = options.sample_spacing.unwrap_or(default_spacing);
-        let (samples, sample_radius) = crate::collision::sampling::sample_surface(&shape, spacing)
+        let (samples, sample_radius) = crate::kernels::collision::sampling::sample_surface(&shape, spacing)
             .map_err(Error::InvalidArgument)?;
         Ok(Tool {
             description,

@@ -6,7 +6,7 @@
 //! `D_m⁻¹`, `D_m = [X_1 - X_0, X_2 - X_0, X_3 - X_0]`, and `b_0 = -(b_1 + b_2 + b_3)`):
 //! 1. `F = Σ_k x_k b_kᵀ = D_s D_m⁻¹` (dimensionless), constant over the tetrahedron;
 //! 2. `R`, the proper rotation maximising `tr(RᵀF)` (inverted `F` handled as for the particles,
-//!    [`crate::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt rotation of
+//!    [`crate::kernels::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt rotation of
 //!    `F`'s first two columns and `T` upper triangular, whose own rotation is close to the
 //!    identity unless the tetrahedron is sheared by tens of degrees; Newton from the identity
 //!    on `T` then gives `R = Q R_T` in one to three iterations;
@@ -29,11 +29,11 @@
 //! particles sums its particles' slots in tetrahedron order. Every particle's force is so
 //! summed in tetrahedron order: the result is bit-identical for any number of threads.
 
-use crate::elastic::{corotated_stress, ElasticModel};
-use crate::lanes::{F4, LANES, M4, V4};
-use crate::math::{Mat3, Quat, Real, Vec3};
-use crate::parallel::{Barrier, Pool, SharedSlice};
-use crate::rotation::{extract_rotations, rotation_from_svd};
+use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
+use crate::kernels::lanes::{F4, LANES, M4, V4};
+use crate::kernels::math::{Mat3, Quat, Real, Vec3};
+use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
+use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 
 /// Newton iterations of a tetrahedron's rotation before the exact SVD fallback (started from
 /// the Gram–Schmidt rotation, they converge in one to three).
@@ -356,7 +356,7 @@ mod tests {
         tets.iter()
             .map(|t| {
                 let [a, b, c, d] = t.map(|k| x[k as usize]);
-                crate::math::tet_volume(&a, &b, &c, &d)
+                crate::kernels::math::tet_volume(&a, &b, &c, &d)
             })
             .collect()
     }

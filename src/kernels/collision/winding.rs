@@ -1,6 +1,6 @@
 //! Inside or outside a closed triangulated surface, by its winding number.
 
-use crate::math::Vec3;
+use crate::kernels::math::Vec3;
 
 /// Whether `point` is inside the closed surface of `triangles` (outward oriented) at positions
 /// `x`: its winding number (the sum of the triangles' solid angles, Van Oosterom & Strackee,

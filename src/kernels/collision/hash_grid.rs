@@ -3,7 +3,7 @@
 //!
 //! Built by counting sort into flat arrays sized when bodies are added: no allocation per step.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// A particle reference: body index and particle index.
 pub type ParticleRef = [u32; 2];

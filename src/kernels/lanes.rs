@@ -10,7 +10,7 @@
 //! `wide` rounds the product, then the sum. So a build with FMA and one without differ in the
 //! last bits; each is deterministic. Only [`F4::sum`] crosses lanes, in a fixed order.
 
-use crate::math::{Mat3, Real, Vec3};
+use crate::kernels::math::{Mat3, Real, Vec3};
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 use wide::{f64x4, CmpLe, CmpLt};
 

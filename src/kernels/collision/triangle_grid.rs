@@ -16,7 +16,7 @@
 //! stretch of surface that is most points, so that only folds, rims and surfaces near each
 //! other cost more than a hash.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// Most cells a grown box spans along an axis, less one (dimensionless).
 const MAX_SPAN: i64 = 3;

@@ -1,6 +1,6 @@
 //! Contact kernels (eq. 9 of the paper): `C = d - r >= 0`, projected on predicted positions.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// A contact that was violated and projected.
 #[derive(Debug, Clone, Copy, PartialEq)]

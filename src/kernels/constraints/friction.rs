@@ -1,6 +1,6 @@
 //! Position-based Coulomb friction (eq. 10–12 of the paper, in the form of Macklin et al. 2014).
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// The friction correction (m) to add to a particle after a contact projection.
 ///

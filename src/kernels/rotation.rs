@@ -7,8 +7,8 @@
 //! objective of Müller, Bender, Chentanez and Macklin (2016), with the SVD ([`rotation_from_svd`])
 //! where those do not converge.
 
-use crate::lanes::{Mask4, F4, LANES, M4, V4};
-use crate::math::{Mat3, Quat, Real};
+use crate::kernels::lanes::{Mask4, F4, LANES, M4, V4};
+use crate::kernels::math::{Mat3, Quat, Real};
 
 /// Convergence tolerance of the rotation extraction: the gradient `|g|` relative to `|F|`
 /// (a rotation error of about this many radians).
@@ -255,7 +255,7 @@ pub fn rotation_from_svd(f: &Mat3) -> Quat {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
+    use crate::kernels::math::Vec3;
 
     /// Deformation gradients that are turned and stretched, sheared, strongly compressed and
     /// inverted (the last one needs the SVD).

@@ -1,7 +1,7 @@
 //! XPBD tetrahedral volume constraint (eq. 13 of the paper): `C = V(p1..p4) - V0 = 0`.
 
-use crate::lanes::{cross, dot, Mask4, F4, V4};
-use crate::math::{Real, Vec3};
+use crate::kernels::lanes::{cross, dot, Mask4, F4, V4};
+use crate::kernels::math::{Real, Vec3};
 
 /// The projection of one tetrahedron's volume constraint.
 ///
@@ -53,7 +53,7 @@ pub fn volume_tet_correction(
 /// updated: the result holds its change).
 ///
 /// Lane-wise IEEE operations in the order of the scalar formula, the same products fused (see
-/// [`crate::lanes`]), so each lane gives the bits of [`volume_tet_correction`] for its
+/// [`crate::kernels::lanes`]), so each lane gives the bits of [`volume_tet_correction`] for its
 /// tetrahedron.
 #[inline(always)]
 pub(crate) fn volume_tet_corrections4(
@@ -101,8 +101,8 @@ pub(crate) struct TetCorrections4 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lanes::LANES;
-    use crate::math::tet_volume;
+    use crate::kernels::lanes::LANES;
+    use crate::kernels::math::tet_volume;
 
     /// Every lane of the four-lane projection gives the scalar projection's bits, whatever the
     /// other lanes hold: soft and hard constraints, a partly and a fully fixed tetrahedron, an

@@ -1,10 +1,10 @@
 //! An array of 3-vectors stored as three arrays of components (structure of arrays).
 //!
 //! The force pass reads the per-pair rest data four pairs at a time, one SIMD register per
-//! component (see [`crate::lanes`]); with the components apart, those are plain contiguous
+//! component (see [`crate::kernels::lanes`]); with the components apart, those are plain contiguous
 //! loads instead of strided gathers.
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// 3-vectors (any unit) by component: `x[e], y[e], z[e]` is vector `e`.
 #[derive(Debug, Clone, Default, PartialEq)]

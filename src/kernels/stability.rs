@@ -4,7 +4,7 @@
 //! Symplectic Euler is stable for a substep `h < 2/ω_max`; the world chooses its number of
 //! substeps from this (and reports when `Settings::max_substeps` is not enough).
 
-use crate::math::{Real, Vec3};
+use crate::kernels::math::{Real, Vec3};
 
 /// Power iterations used for the estimate.
 const ITERATIONS: usize = 60;
