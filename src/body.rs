@@ -6,14 +6,14 @@
 //! A body stores its particles in particle order, the mesh's nodes sorted for memory locality
 //! ([`ParticleOrder`]); its Rust API speaks that order, the C ABI and the FMU the mesh's.
 
-use crate::body_model::{BodyModel, Material};
+use crate::model::body_model::{BodyModel, Material};
 use crate::derived::{Derived, DerivedFrom};
 use crate::kernels::point_elasticity::{self, ElasticModel};
 use crate::kernels::lanes::{F4, LANES, V4};
 use crate::kernels::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
 use crate::kernels::neighbours::Neighbourhoods;
 use crate::kernels::parallel::{Pool, SharedSlice};
-use crate::particle_order::ParticleOrder;
+use crate::model::particle_order::ParticleOrder;
 use std::sync::Arc;
 
 /// Largest distance (in body sizes: the diagonal of the rest bounding box) of a particle from

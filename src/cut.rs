@@ -22,10 +22,10 @@
 //! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
 
 use crate::body::Body;
-use crate::body_model::BodyModel;
+use crate::model::body_model::BodyModel;
 use crate::kernels::colouring::TetColouring;
 use crate::derived::StabilityBase;
-use crate::dual_cells::DualCells;
+use crate::model::dual_cells::DualCells;
 use crate::kernels::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::kernels::neighbours::Neighbourhoods;

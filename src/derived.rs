@@ -23,7 +23,7 @@
 //! that has only a body (its public helpers, the linear statics) reads [`Derived::from`], the
 //! settings the body was derived under, which are the world's.
 
-use crate::body_model::BodyModel;
+use crate::model::body_model::BodyModel;
 use crate::kernels::point_elasticity::{self as elastic, ElasticModel, ForceInputs};
 use crate::kernels::math::{Quat, Real, Vec3};
 use crate::kernels::parallel::Pool;

@@ -25,19 +25,16 @@
 #![warn(missing_docs)]
 
 pub(crate) mod body;
-pub(crate) mod body_model;
-pub(crate) mod consistency;
 pub mod cut;
 pub(crate) mod derived;
 pub(crate) mod divergence;
-pub(crate) mod dual_cells;
 pub(crate) mod error;
 pub mod ffi;
 pub(crate) mod kernels;
 pub mod grasp;
 pub mod mesh;
+pub(crate) mod model;
 pub mod needle;
-pub(crate) mod particle_order;
 pub(crate) mod particles;
 pub mod render;
 pub(crate) mod scene;
@@ -51,7 +48,7 @@ pub mod statics;
 pub(crate) mod world;
 
 pub use body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
-pub use body_model::{
+pub use model::body_model::{
     BodyModel, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
     PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
 };
@@ -65,7 +62,7 @@ pub use grasp::GraspOptions;
 pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use needle::{NeedleOptions, NeedleState};
 pub use kernels::neighbours::MAX_NEIGHBOURS;
-pub use particle_order::ParticleOrder;
+pub use model::particle_order::ParticleOrder;
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
 pub use settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
 pub use world::{RenderSurfaceId, World};

@@ -2,7 +2,7 @@
 //! their state into caller buffers.
 
 use crate::body::Body;
-use crate::body_model::{BodyModel, BodyOptions, Material};
+use crate::model::body_model::{BodyModel, BodyOptions, Material};
 use crate::ffi::args::{
     all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,
 };

@@ -45,7 +45,7 @@ pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::body::{volume_on, Body};
-use crate::body_model::BodyModel;
+use crate::model::body_model::BodyModel;
 use crate::scene::tool::{Pose, ToolShape, Wrench};
 use crate::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;

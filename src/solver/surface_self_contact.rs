@@ -54,7 +54,7 @@
 //! for any thread count.
 
 use crate::body::Body;
-use crate::body_model::BodyModel;
+use crate::model::body_model::BodyModel;
 use crate::kernels::collision::triangle_grid::TriangleGrid;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};

@@ -3,7 +3,7 @@
 //! when bodies are added and reused, so that a step allocates nothing.
 
 use crate::body::Body;
-use crate::body_model::BodyModel;
+use crate::model::body_model::BodyModel;
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
 use crate::kernels::math::{Real, Vec3};

@@ -8,7 +8,7 @@ mod saved_state;
 mod state;
 
 use crate::body::Body;
-use crate::body_model::{BodyModel, BodyOptions};
+use crate::model::body_model::{BodyModel, BodyOptions};
 use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::cut::{Blade, CutReport};
 use crate::derived::DerivedFrom;

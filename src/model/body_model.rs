@@ -13,13 +13,13 @@
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 
 use crate::kernels::colouring::TetColouring;
-use crate::consistency;
-use crate::dual_cells::DualCells;
+use crate::model::consistency;
+use crate::model::dual_cells::DualCells;
 use crate::error::{check_finite, check_positive, Error};
 use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::kernels::neighbours::{self, Neighbourhoods, SupportRadius};
-use crate::particle_order::ParticleOrder;
+use crate::model::particle_order::ParticleOrder;
 use crate::kernels::tet_elasticity::TetElements;
 use std::sync::Arc;
 
