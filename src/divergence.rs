@@ -8,9 +8,9 @@
 //! flattened state on purpose recovers through states outside the volume range, and each of
 //! those steps brings it closer.
 
-use crate::body::{volume_of, Body};
+use crate::scene::body::{volume_of, Body};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
-use crate::settings::DivergenceLimits;
+use crate::scene::settings::DivergenceLimits;
 
 /// The particle half of the check over a run of particles: the first particle that is
 /// non-finite or too fast, and the bounding box (m) of the particles before it. Made in the

@@ -24,9 +24,6 @@
 //! ```
 #![warn(missing_docs)]
 
-pub(crate) mod body;
-pub mod cut;
-pub(crate) mod derived;
 pub(crate) mod divergence;
 pub(crate) mod error;
 pub mod ffi;
@@ -35,10 +32,8 @@ pub mod grasp;
 pub mod mesh;
 pub(crate) mod model;
 pub mod needle;
-pub(crate) mod particles;
 pub mod render;
 pub(crate) mod scene;
-pub(crate) mod settings;
 pub(crate) mod solver;
 // The saved-state byte format: public as `tissuesim::state`, in a file whose name says what it
 // holds (the state as a value is `scene::state`).
@@ -47,7 +42,9 @@ pub mod state;
 pub mod statics;
 pub(crate) mod world;
 
-pub use body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
+pub use scene::cut;
+
+pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
 pub use model::body_model::{
     BodyModel, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
     PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
@@ -56,7 +53,7 @@ pub use scene::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,
 };
-pub use cut::{Blade, CutReport};
+pub use scene::cut::{Blade, CutReport};
 pub use error::Error;
 pub use grasp::GraspOptions;
 pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
@@ -64,5 +61,5 @@ pub use needle::{NeedleOptions, NeedleState};
 pub use kernels::neighbours::MAX_NEIGHBOURS;
 pub use model::particle_order::ParticleOrder;
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
-pub use settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
+pub use scene::settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
 pub use world::{RenderSurfaceId, World};

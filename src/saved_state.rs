@@ -32,7 +32,7 @@
 //! [`World::state_size`]: crate::World::state_size
 //! [`World::set_state`]: crate::World::set_state
 
-use crate::body::ParticleState;
+use crate::scene::body::ParticleState;
 use crate::scene::tool::{Pose, Wrench};
 use crate::error::Error;
 use crate::grasp::{Attachment, Grasp};

@@ -20,11 +20,11 @@
 //! derived under (`Derived::from`, the world's settings): the public functions here are given
 //! only a body, and the stiffness must be that of the constants it holds.
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::kernels::point_elasticity::ElasticModel;
 use crate::error::Error;
 use crate::kernels::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
-use crate::settings::{ElasticScheme, VolumeScheme};
+use crate::scene::settings::{ElasticScheme, VolumeScheme};
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};

@@ -1,7 +1,7 @@
 //! Bodies: adding them (mesh file, arrays, the default organ), fixing particles, and reading
 //! their state into caller buffers.
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::model::body_model::{BodyModel, BodyOptions, Material};
 use crate::ffi::args::{
     all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,

@@ -1,7 +1,7 @@
 //! Cutting from C: a blade's swept edge removes the neighbour pairs and tetrahedra it crosses
 //! (see the Rust `World::cut` and `World::make_blade`).
 
-use crate::cut::Blade;
+use crate::scene::cut::Blade;
 use crate::ffi::args::{all_finite, input_slice, non_null, world_mut, world_ref, write};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;

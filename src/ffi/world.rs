@@ -6,7 +6,7 @@ use crate::ffi::error::{fail, FfiResult};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::kernels::math::Vec3;
-use crate::settings::{ContactMode, DivergenceLimits, Settings};
+use crate::scene::settings::{ContactMode, DivergenceLimits, Settings};
 use crate::world::World;
 
 /// How tool-tissue contact is detected (the values of ts_settings.contact_mode).

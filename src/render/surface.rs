@@ -3,7 +3,7 @@
 
 use super::bind::{bind, BindReport, Binding};
 use super::mesh::RenderMesh;
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
 use crate::scene::BodyId;

@@ -5,20 +5,31 @@
 //! A [`Scene`] holds no scratch memory and no threads: `solver::Pipeline` owns those and steps
 //! the scene it is handed; [`World`](crate::World) is the public API over the two. The scene's
 //! dynamic state as one value, [`WorldState`], is in [`state`].
+//!
+//! Beside it, what the scene is made of: [`body`] (a body in a world: its model, derived data,
+//! fixed particles and particle state), [`derived`] (what a body derives from the settings and
+//! its model), [`settings`] (`Settings`), [`tool`] (the tools: shapes, poses, wrench),
+//! [`particles`] (the narrow view of a body that the interactions act on) and [`cut`] (a body's
+//! topology changed by a blade, and restored from a saved state's cut sets).
 
+pub(crate) mod body;
+pub mod cut;
+pub(crate) mod derived;
+pub(crate) mod particles;
+pub(crate) mod settings;
 pub(crate) mod state;
 pub(crate) mod tool;
 
 pub use state::WorldState;
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::scene::tool::{Tool, ToolLoad};
-use crate::cut::CutReport;
+use crate::scene::cut::CutReport;
 use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::kernels::math::Real;
 use crate::needle::Needle;
-use crate::settings::Settings;
+use crate::scene::settings::Settings;
 
 /// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
 /// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along

@@ -13,9 +13,9 @@
 //! [`World::state_into`]: crate::World::state_into
 //! [`World::set_state`]: crate::World::set_state
 
-use crate::body::{Body, ParticleState};
+use crate::scene::body::{Body, ParticleState};
 use crate::scene::tool::{Pose, Wrench};
-use crate::cut::CutSets;
+use crate::scene::cut::CutSets;
 use crate::error::Error;
 use crate::grasp::Grasp;
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
@@ -100,7 +100,7 @@ impl BodyState {
         BodyState {
             particles: body.state.clone(),
             fixed: body.fixed.clone(),
-            cuts: crate::cut::cut_sets(body),
+            cuts: crate::scene::cut::cut_sets(body),
         }
     }
 }
@@ -116,7 +116,7 @@ impl Scene {
                 Some(s) => {
                     s.particles.assign_on(&body.state, pool);
                     s.fixed.clone_from(&body.fixed);
-                    s.cuts = crate::cut::cut_sets(body);
+                    s.cuts = crate::scene::cut::cut_sets(body);
                 }
                 None => out.bodies.push(BodyState::of(body)),
             }
@@ -250,7 +250,7 @@ impl Scene {
     pub(crate) fn apply_state(&mut self, state: &WorldState) {
         self.time = state.time;
         for (body, s) in self.bodies.iter_mut().zip(&state.bodies) {
-            crate::cut::restore(body, &s.cuts);
+            crate::scene::cut::restore(body, &s.cuts);
             if body.fixed != s.fixed {
                 body.fixed.copy_from_slice(&s.fixed);
                 body.fixed_flags_changed();
@@ -293,7 +293,7 @@ fn check_body(s: &BodyState, body: &Body) -> Result<(), String> {
         return Err("non-finite particle rotation".into());
     }
     if let Some(sets) = &s.cuts {
-        let (pairs, tets) = crate::cut::load_time_counts(body);
+        let (pairs, tets) = crate::scene::cut::load_time_counts(body);
         for (list, limit) in [(&sets.0, pairs), (&sets.1, tets)] {
             let increasing = list.windows(2).all(|w| w[0] < w[1]);
             if !increasing || list.last().is_some_and(|&v| v as usize >= limit) {

@@ -44,17 +44,17 @@ pub(crate) use surface_contact::SurfaceScratch;
 pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
-use crate::body::{volume_on, Body};
+use crate::scene::body::{volume_on, Body};
 use crate::model::body_model::BodyModel;
 use crate::scene::tool::{Pose, ToolShape, Wrench};
-use crate::cut::{Blade, CutReport};
+use crate::scene::cut::{Blade, CutReport};
 use crate::divergence::ParticleScan;
 use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
-use crate::particles::{ParticleView, ParticleViews};
+use crate::scene::particles::{ParticleView, ParticleViews};
 use crate::scene::{Scene, StepReport, ToolSlot};
-use crate::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
+use crate::scene::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
 use parry3d_f64::math::{Isometry, Point};
 
 /// The bodies' particle views over their step scratch, by body index.
@@ -192,7 +192,7 @@ impl Pipeline {
                 to: edge(&t.target),
             };
             for body in &mut scene.bodies {
-                let r = crate::cut::cut(body, &blade);
+                let r = crate::scene::cut::cut(body, &blade);
                 cut.pairs += r.pairs;
                 cut.tets += r.tets;
                 cut.isolated += r.isolated;

@@ -2,7 +2,7 @@
 //! friction. (Contact of a body with itself is the surface self-contact,
 //! `crate::solver::surface_self_contact`.)
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::kernels::constraints::contact::project_particle_particle;
 use crate::kernels::constraints::friction::friction_correction;

@@ -1,10 +1,10 @@
 //! Forces and the symplectic prediction of a body for one substep.
 
-use crate::body::{Body, ROTATION_ITERATIONS};
+use crate::scene::body::{Body, ROTATION_ITERATIONS};
 use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
-use crate::settings::ElasticScheme;
+use crate::scene::settings::ElasticScheme;
 use crate::solver::StepScratch;
 use crate::kernels::tet_elasticity::{self, TetForceInputs};
 

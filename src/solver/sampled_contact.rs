@@ -12,7 +12,7 @@ use crate::scene::tool::{Pose, Tool, ToolLoad};
 use crate::kernels::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
-use crate::particles::ParticleView;
+use crate::scene::particles::ParticleView;
 use crate::solver::tool_motion_at;
 use parry3d_f64::math::Point;
 

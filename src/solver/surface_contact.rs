@@ -34,7 +34,7 @@ use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
-use crate::particles::{ParticleView, SURFACE_SKIN};
+use crate::scene::particles::{ParticleView, SURFACE_SKIN};
 use crate::solver::tool_motion_at;
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;

@@ -53,7 +53,7 @@
 //! vertices in increasing order and the triangles of a cell in boundary order: the same bits
 //! for any thread count.
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::model::body_model::BodyModel;
 use crate::kernels::collision::triangle_grid::TriangleGrid;
 use crate::kernels::constraints::friction::friction_correction;

@@ -2,12 +2,12 @@
 //! [`Pipeline`](super::Pipeline) apart from the scene (bodies' model and state, tools), sized
 //! when bodies are added and reused, so that a step allocates nothing.
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::model::body_model::BodyModel;
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::divergence::ParticleScan;
 use crate::kernels::math::{Real, Vec3};
-use crate::particles::ParticleView;
+use crate::scene::particles::ParticleView;
 use crate::scene::WorldState;
 use crate::solver::{SelfContactScratch, SurfaceScratch};
 

@@ -7,11 +7,11 @@
 mod saved_state;
 mod state;
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::model::body_model::{BodyModel, BodyOptions};
 use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
-use crate::cut::{Blade, CutReport};
-use crate::derived::DerivedFrom;
+use crate::scene::cut::{Blade, CutReport};
+use crate::scene::derived::DerivedFrom;
 use crate::error::Error;
 use crate::grasp::{Grasp, GraspOptions};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
@@ -19,7 +19,7 @@ use crate::mesh::TetMesh;
 use crate::needle::{Needle, NeedleOptions, NeedleState};
 use crate::render::{RenderMesh, RenderSurface};
 use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
-use crate::settings::Settings;
+use crate::scene::settings::Settings;
 use crate::solver::Pipeline;
 use std::sync::Arc;
 
@@ -245,7 +245,7 @@ impl World {
         if ends.clone().any(|p| !is_finite_vec(p)) {
             return Err(Error::NonFinite("blade edge".into()));
         }
-        let report = crate::cut::cut(self.scene.body_mut(id)?, blade);
+        let report = crate::scene::cut::cut(self.scene.body_mut(id)?, blade);
         self.pipeline.fit_boundaries(&self.scene.bodies);
         Ok(report)
     }

@@ -11,7 +11,7 @@ impl World {
     /// without taking its state).
     pub fn state_size(&self) -> usize {
         let bodies = self.scene.bodies.iter().map(|b| {
-            let cuts = crate::cut::cut_sets(b).map_or(0, |c| c.0.len() + c.1.len());
+            let cuts = crate::scene::cut::cut_sets(b).map_or(0, |c| c.0.len() + c.1.len());
             (b.particle_count(), cuts)
         });
         let tools = (self.scene.tools.iter().flatten()).map(|s| {

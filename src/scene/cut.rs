@@ -21,10 +21,10 @@
 //! removed in place. The set of cut pairs and tetrahedra is part of the saved state; restoring
 //! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
 
-use crate::body::Body;
+use crate::scene::body::Body;
 use crate::model::body_model::BodyModel;
 use crate::kernels::colouring::TetColouring;
-use crate::derived::StabilityBase;
+use crate::scene::derived::StabilityBase;
 use crate::model::dual_cells::DualCells;
 use crate::kernels::math::{Mat3, Real, Vec3};
 use crate::mesh::TetMesh;

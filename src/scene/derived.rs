@@ -27,7 +27,7 @@ use crate::model::body_model::BodyModel;
 use crate::kernels::point_elasticity::{self as elastic, ElasticModel, ForceInputs};
 use crate::kernels::math::{Quat, Real, Vec3};
 use crate::kernels::parallel::Pool;
-use crate::settings::{ElasticScheme, Settings, VolumeScheme};
+use crate::scene::settings::{ElasticScheme, Settings, VolumeScheme};
 use crate::kernels::stability;
 use crate::kernels::tet_elasticity::{self, TetForceInputs};
 

@@ -7,7 +7,7 @@
 //! ([`ParticleOrder`]); its Rust API speaks that order, the C ABI and the FMU the mesh's.
 
 use crate::model::body_model::{BodyModel, Material};
-use crate::derived::{Derived, DerivedFrom};
+use crate::scene::derived::{Derived, DerivedFrom};
 use crate::kernels::point_elasticity::{self, ElasticModel};
 use crate::kernels::lanes::{F4, LANES, V4};
 use crate::kernels::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
@@ -114,7 +114,7 @@ pub struct Body {
     /// flags ([`Body::fixed_flags_changed`]).
     pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
-    pub(crate) cuts: Option<Box<crate::cut::CutState>>,
+    pub(crate) cuts: Option<Box<crate::scene::cut::CutState>>,
 }
 
 /// Newton iterations of the rotation extraction per particle per substep before the exact SVD
@@ -273,7 +273,7 @@ impl Body {
     /// Thickness of the contact skin over the boundary surface (m): tools in the exact-shape
     /// contact mode touch the surface this far out of it (a tenth of the particle radius).
     pub fn contact_skin(&self) -> Real {
-        crate::particles::SURFACE_SKIN * self.model.particle_radius
+        crate::scene::particles::SURFACE_SKIN * self.model.particle_radius
     }
     /// Total mass (kg).
     pub fn mass(&self) -> Real {
@@ -359,7 +359,7 @@ pub(crate) fn volume_on(pool: &Pool, x: &[Vec3], boundary: &[[u32; 3]]) -> Real 
 }
 
 /// Runs of boundary triangles in a volume sum: enough for any thread count a world takes.
-const VOLUME_RUNS: usize = crate::settings::MAX_THREADS;
+const VOLUME_RUNS: usize = crate::scene::settings::MAX_THREADS;
 
 /// Run `k` of the volume sum of [`volume_of`] (m³): the signed volumes of the tetrahedra its
 /// triangles span with a point of the surface, four triangles a lane (the last ones of the run
