@@ -27,11 +27,10 @@
 pub(crate) mod divergence;
 pub(crate) mod error;
 pub mod ffi;
+pub(crate) mod interaction;
 pub(crate) mod kernels;
-pub mod grasp;
 pub mod mesh;
 pub(crate) mod model;
-pub mod needle;
 pub mod render;
 pub(crate) mod scene;
 pub(crate) mod solver;
@@ -42,6 +41,7 @@ pub mod state;
 pub mod statics;
 pub(crate) mod world;
 
+pub use interaction::{grasp, needle};
 pub use scene::cut;
 
 pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
@@ -55,9 +55,9 @@ pub use scene::tool::{
 };
 pub use scene::cut::{Blade, CutReport};
 pub use error::Error;
-pub use grasp::GraspOptions;
+pub use interaction::grasp::GraspOptions;
 pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
-pub use needle::{NeedleOptions, NeedleState};
+pub use interaction::needle::{NeedleOptions, NeedleState};
 pub use kernels::neighbours::MAX_NEIGHBOURS;
 pub use model::particle_order::ParticleOrder;
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};

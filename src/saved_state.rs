@@ -35,9 +35,9 @@
 use crate::scene::body::ParticleState;
 use crate::scene::tool::{Pose, Wrench};
 use crate::error::Error;
-use crate::grasp::{Attachment, Grasp};
+use crate::interaction::grasp::{Attachment, Grasp};
 use crate::kernels::math::{Quat, Real, Vec3};
-use crate::needle::ShaftHold;
+use crate::interaction::needle::ShaftHold;
 use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use std::sync::Arc;
 

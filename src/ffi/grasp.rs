@@ -4,7 +4,7 @@ use crate::ffi::args::{non_null, world_mut, world_ref, write};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::grasp::GraspOptions;
+use crate::interaction::grasp::GraspOptions;
 use crate::scene::ToolId;
 
 /// How a tool grasps. ts_grasp_options_default gives automatic reach and compliance and a grasp

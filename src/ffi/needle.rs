@@ -5,7 +5,7 @@ use crate::ffi::args::{non_null, world_mut, world_ref, write};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
-use crate::needle::NeedleOptions;
+use crate::interaction::needle::NeedleOptions;
 use crate::scene::ToolId;
 
 /// How a needle punctures and holds the tissue. ts_needle_options_default gives 1 N, 20 N/m and

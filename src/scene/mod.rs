@@ -26,9 +26,9 @@ use crate::scene::body::Body;
 use crate::scene::tool::{Tool, ToolLoad};
 use crate::scene::cut::CutReport;
 use crate::error::Error;
-use crate::grasp::Grasp;
+use crate::interaction::grasp::Grasp;
 use crate::kernels::math::Real;
-use crate::needle::Needle;
+use crate::interaction::needle::Needle;
 use crate::scene::settings::Settings;
 
 /// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not

@@ -14,7 +14,8 @@
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
 //!    tool contact (each tool against each body, friction, wrench:
-//!    [`surface_contact`] against the boundary triangles, or [`sampled_contact`], the paper's
+//!    [`surface_contact`](crate::interaction::surface_contact) against the boundary triangles, or
+//!    [`sampled_contact`](crate::interaction::sampled_contact), the paper's
 //!    tool samples against the particles; off between a needle and the body it punctured and
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
@@ -34,13 +35,11 @@
 
 mod organ_contact;
 mod predict;
-mod sampled_contact;
-mod surface_contact;
 mod surface_self_contact;
 mod volume;
 mod workspace;
 
-pub(crate) use surface_contact::SurfaceScratch;
+pub(crate) use crate::interaction::surface_contact::SurfaceScratch;
 pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
@@ -52,10 +51,11 @@ use crate::divergence::ParticleScan;
 use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
+use crate::interaction::{sampled_contact, surface_contact};
 use crate::scene::particles::{ParticleView, ParticleViews};
 use crate::scene::{Scene, StepReport, ToolSlot};
 use crate::scene::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
-use parry3d_f64::math::{Isometry, Point};
+use parry3d_f64::math::Point;
 
 /// The bodies' particle views over their step scratch, by body index.
 struct Views<'a> {
@@ -67,12 +67,6 @@ impl ParticleViews for Views<'_> {
     fn view(&mut self, b: usize) -> ParticleView<'_> {
         self.scratch[b].view(&self.bodies[b])
     }
-}
-
-/// How far (m) the point of a tool now at `point` moved in this substep: `back` maps a point
-/// attached to the tool at the substep's end to where it was at its start.
-fn tool_motion_at(back: &Isometry<Real>, point: &Vec3) -> Vec3 {
-    point - back.transform_point(&Point::from(*point)).coords
 }
 
 /// The step's machinery: the scratch memory of a step and the threads, no scene. Sized for the

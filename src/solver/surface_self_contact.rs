@@ -58,7 +58,7 @@ use crate::model::body_model::BodyModel;
 use crate::kernels::collision::triangle_grid::TriangleGrid;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
-use crate::solver::surface_contact::MAX_CORNER_SHARE;
+use crate::interaction::surface_contact::MAX_CORNER_SHARE;
 use crate::solver::StepScratch;
 use parry3d_f64::math::Point;
 use parry3d_f64::query::PointQuery;

@@ -35,7 +35,7 @@ use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::scene::particles::{ParticleView, SURFACE_SKIN};
-use crate::solver::tool_motion_at;
+use crate::interaction::tool_motion_at;
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CSOPoint, GJKResult, VoronoiSimplex};

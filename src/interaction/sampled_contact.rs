@@ -13,7 +13,7 @@ use crate::kernels::constraints::contact::{project_point_sphere, push_out_of_sol
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::scene::particles::ParticleView;
-use crate::solver::tool_motion_at;
+use crate::interaction::tool_motion_at;
 use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to
