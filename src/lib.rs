@@ -24,7 +24,6 @@
 //! ```
 #![warn(missing_docs)]
 
-pub(crate) mod divergence;
 pub(crate) mod error;
 pub mod ffi;
 pub(crate) mod interaction;
@@ -38,28 +37,28 @@ pub(crate) mod solver;
 // holds (the state as a value is `scene::state`).
 #[path = "saved_state.rs"]
 pub mod state;
-pub mod statics;
 pub(crate) mod world;
 
 pub use interaction::{grasp, needle};
 pub use scene::cut;
+pub use solver::statics;
 
-pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
+pub use error::Error;
+pub use interaction::grasp::GraspOptions;
+pub use interaction::needle::{NeedleOptions, NeedleState};
+pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
+pub use kernels::neighbours::MAX_NEIGHBOURS;
 pub use model::body_model::{
     BodyModel, BodyOptions, Material, DENSITY_RANGE, MAX_POISSON_RATIO, MIN_POISSON_RATIO,
     PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
 };
+pub use model::particle_order::ParticleOrder;
+pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
+pub use scene::cut::{Blade, CutReport};
+pub use scene::settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
 pub use scene::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,
 };
-pub use scene::cut::{Blade, CutReport};
-pub use error::Error;
-pub use interaction::grasp::GraspOptions;
-pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
-pub use interaction::needle::{NeedleOptions, NeedleState};
-pub use kernels::neighbours::MAX_NEIGHBOURS;
-pub use model::particle_order::ParticleOrder;
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
-pub use scene::settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
 pub use world::{RenderSurfaceId, World};

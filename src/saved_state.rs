@@ -32,13 +32,13 @@
 //! [`World::state_size`]: crate::World::state_size
 //! [`World::set_state`]: crate::World::set_state
 
-use crate::scene::body::ParticleState;
-use crate::scene::tool::{Pose, Wrench};
 use crate::error::Error;
 use crate::interaction::grasp::{Attachment, Grasp};
-use crate::kernels::math::{Quat, Real, Vec3};
 use crate::interaction::needle::ShaftHold;
+use crate::kernels::math::{Quat, Real, Vec3};
+use crate::scene::body::ParticleState;
 use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
+use crate::scene::tool::{Pose, Wrench};
 use std::sync::Arc;
 
 /// Version of the byte format written by [`World::save_state`](crate::World::save_state).

@@ -1,8 +1,6 @@
 //! Bodies: adding them (mesh file, arrays, the default organ), fixing particles, and reading
 //! their state into caller buffers.
 
-use crate::scene::body::Body;
-use crate::model::body_model::{BodyModel, BodyOptions, Material};
 use crate::ffi::args::{
     all_finite, element_count, input_slice, non_null, read_vec3, world_mut, world_ref, write,
 };
@@ -12,6 +10,8 @@ use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::kernels::math::Vec3;
 use crate::mesh::{self, TetMesh};
+use crate::model::body_model::{BodyModel, BodyOptions, Material};
+use crate::scene::body::Body;
 use crate::scene::BodyId;
 use std::ffi::{c_char, CStr};
 use std::mem::MaybeUninit;

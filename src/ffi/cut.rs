@@ -1,12 +1,12 @@
 //! Cutting from C: a blade's swept edge removes the neighbour pairs and tetrahedra it crosses
 //! (see the Rust `World::cut` and `World::make_blade`).
 
-use crate::scene::cut::Blade;
 use crate::ffi::args::{all_finite, input_slice, non_null, world_mut, world_ref, write};
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::kernels::math::Vec3;
+use crate::scene::cut::Blade;
 use crate::scene::{BodyId, ToolId};
 
 /// What a cut removed.

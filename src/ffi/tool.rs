@@ -2,7 +2,6 @@
 //! mesh from arrays or OBJ), adding and removing them, their poses, friction
 //! and the contact wrench the tissue exerts on them.
 
-use crate::scene::tool::{Pose, ToolOptions, ToolShape};
 use crate::ffi::args::{element_count, input_slice, non_null, world_mut, world_ref, write};
 use crate::ffi::body::c_path;
 use crate::ffi::error::FfiResult;
@@ -11,6 +10,7 @@ use crate::ffi::status::ts_status;
 use crate::ffi::world::ts_world;
 use crate::kernels::math::Vec3;
 use crate::mesh;
+use crate::scene::tool::{Pose, ToolOptions, ToolShape};
 use crate::scene::ToolId;
 use std::ffi::c_char;
 

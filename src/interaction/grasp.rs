@@ -13,11 +13,11 @@
 //! jaws enclose the tissue, and contact would fight the attachments);
 //! [`World::release`](crate::World::release) lets go and contact acts again.
 
-use crate::scene::body::Body;
-use crate::scene::tool::{Pose, Tool, ToolLoad};
 use crate::error::{check_finite, Error};
 use crate::kernels::math::{Real, Vec3};
+use crate::scene::body::Body;
 use crate::scene::particles::ParticleViews;
+use crate::scene::tool::{Pose, Tool, ToolLoad};
 use parry3d_f64::math::Point;
 
 /// How a tool grasps.

@@ -22,11 +22,11 @@
 //! the tip withdraws past are let go; once the tip is back behind the entry point the needle is
 //! out and contact acts again.
 
-use crate::scene::body::Body;
-use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use crate::error::{check_finite, Error};
 use crate::kernels::math::{Real, Vec3};
+use crate::scene::body::Body;
 use crate::scene::particles::ParticleViews;
+use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use parry3d_f64::math::Point;
 
 /// How a needle punctures and holds the tissue.

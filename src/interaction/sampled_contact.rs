@@ -8,12 +8,14 @@
 //! meets the samples only once it is out: the samples alone would push it out of each sample
 //! separately, in directions that fight, and a particle deep inside meets none of them.
 
-use crate::scene::tool::{Pose, Tool, ToolLoad};
-use crate::kernels::constraints::contact::{project_point_sphere, push_out_of_solid, ContactProjection};
+use crate::interaction::tool_motion_at;
+use crate::kernels::constraints::contact::{
+    project_point_sphere, push_out_of_solid, ContactProjection,
+};
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::scene::particles::ParticleView;
-use crate::interaction::tool_motion_at;
+use crate::scene::tool::{Pose, Tool, ToolLoad};
 use parry3d_f64::math::Point;
 
 /// Project the contacts between the surface samples of `tool` (moving from `motion.0` to

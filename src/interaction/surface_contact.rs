@@ -30,12 +30,12 @@
 //!   far side, on the line along `n` through the foot of the tool's middle, is `r` in front of it;
 //! - otherwise (a tool inside the body, e.g. after a teleport) the minimal separation.
 
-use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
+use crate::interaction::tool_motion_at;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::scene::particles::{ParticleView, SURFACE_SKIN};
-use crate::interaction::tool_motion_at;
+use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use parry3d_f64::math::{Isometry, Point};
 use parry3d_f64::query::epa::EPA;
 use parry3d_f64::query::gjk::{self, CSOPoint, GJKResult, VoronoiSimplex};

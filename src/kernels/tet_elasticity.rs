@@ -29,10 +29,10 @@
 //! particles sums its particles' slots in tetrahedron order. Every particle's force is so
 //! summed in tetrahedron order: the result is bit-identical for any number of threads.
 
-use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::lanes::{F4, LANES, M4, V4};
 use crate::kernels::math::{Mat3, Quat, Real, Vec3};
 use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
+use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 
 /// Newton iterations of a tetrahedron's rotation before the exact SVD fallback (started from

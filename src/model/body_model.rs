@@ -12,15 +12,15 @@
 //! A cut is the one operation that changes a model; it makes the cut body's own copy first
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 
+use crate::error::{check_finite, check_positive, Error};
 use crate::kernels::colouring::TetColouring;
+use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
+use crate::kernels::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::kernels::tet_elasticity::TetElements;
+use crate::mesh::TetMesh;
 use crate::model::consistency;
 use crate::model::dual_cells::DualCells;
-use crate::error::{check_finite, check_positive, Error};
-use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
-use crate::mesh::TetMesh;
-use crate::kernels::neighbours::{self, Neighbourhoods, SupportRadius};
 use crate::model::particle_order::ParticleOrder;
-use crate::kernels::tet_elasticity::TetElements;
 use std::sync::Arc;
 
 /// An isotropic linear-elastic material (SI units).

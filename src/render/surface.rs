@@ -3,9 +3,9 @@
 
 use super::bind::{bind, BindReport, Binding};
 use super::mesh::RenderMesh;
-use crate::scene::body::Body;
 use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
+use crate::scene::body::Body;
 use crate::scene::BodyId;
 use std::path::Path;
 

@@ -6,14 +6,14 @@
 //! A body stores its particles in particle order, the mesh's nodes sorted for memory locality
 //! ([`ParticleOrder`]); its Rust API speaks that order, the C ABI and the FMU the mesh's.
 
-use crate::model::body_model::{BodyModel, Material};
-use crate::scene::derived::{Derived, DerivedFrom};
-use crate::kernels::point_elasticity::{self, ElasticModel};
 use crate::kernels::lanes::{F4, LANES, V4};
 use crate::kernels::math::{is_finite_vec, Mat3, Quat, Real, Vec3};
 use crate::kernels::neighbours::Neighbourhoods;
 use crate::kernels::parallel::{Pool, SharedSlice};
+use crate::kernels::point_elasticity::{self, ElasticModel};
+use crate::model::body_model::{BodyModel, Material};
 use crate::model::particle_order::ParticleOrder;
+use crate::scene::derived::{Derived, DerivedFrom};
 use std::sync::Arc;
 
 /// Largest distance (in body sizes: the diagonal of the rest bounding box) of a particle from
@@ -237,7 +237,11 @@ impl Body {
     /// winding number about the point is above one half). Cost: one pass over the boundary
     /// triangles.
     pub fn contains(&self, point: &Vec3) -> bool {
-        crate::kernels::collision::winding::inside_surface(point, &self.state.x, &self.model.boundary)
+        crate::kernels::collision::winding::inside_surface(
+            point,
+            &self.state.x,
+            &self.model.boundary,
+        )
     }
     /// Current volume (m³): the sum of the signed tetrahedron volumes, computed as the volume
     /// the boundary surface encloses (the same sum: the inner faces cancel), a pass over the

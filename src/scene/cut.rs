@@ -21,15 +21,15 @@
 //! removed in place. The set of cut pairs and tetrahedra is part of the saved state; restoring
 //! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
 
-use crate::scene::body::Body;
-use crate::model::body_model::BodyModel;
 use crate::kernels::colouring::TetColouring;
-use crate::scene::derived::StabilityBase;
-use crate::model::dual_cells::DualCells;
 use crate::kernels::math::{Mat3, Real, Vec3};
-use crate::mesh::TetMesh;
 use crate::kernels::neighbours::Neighbourhoods;
 use crate::kernels::tet_elasticity::TetElements;
+use crate::mesh::TetMesh;
+use crate::model::body_model::BodyModel;
+use crate::model::dual_cells::DualCells;
+use crate::scene::body::Body;
+use crate::scene::derived::StabilityBase;
 use std::sync::Arc;
 
 /// A blade's edge at the start and at the end of its motion over one step (m, world frame).

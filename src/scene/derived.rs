@@ -23,13 +23,13 @@
 //! that has only a body (its public helpers, the linear statics) reads [`Derived::from`], the
 //! settings the body was derived under, which are the world's.
 
-use crate::model::body_model::BodyModel;
-use crate::kernels::point_elasticity::{self as elastic, ElasticModel, ForceInputs};
 use crate::kernels::math::{Quat, Real, Vec3};
 use crate::kernels::parallel::Pool;
-use crate::scene::settings::{ElasticScheme, Settings, VolumeScheme};
+use crate::kernels::point_elasticity::{self as elastic, ElasticModel, ForceInputs};
 use crate::kernels::stability;
 use crate::kernels::tet_elasticity::{self, TetForceInputs};
+use crate::model::body_model::BodyModel;
+use crate::scene::settings::{ElasticScheme, Settings, VolumeScheme};
 
 /// The settings a body's elastic constants and volume compliance derive from (the fields of
 /// [`Settings`] of the same names).

@@ -22,14 +22,14 @@ pub(crate) mod tool;
 
 pub use state::WorldState;
 
-use crate::scene::body::Body;
-use crate::scene::tool::{Tool, ToolLoad};
-use crate::scene::cut::CutReport;
 use crate::error::Error;
 use crate::interaction::grasp::Grasp;
-use crate::kernels::math::Real;
 use crate::interaction::needle::Needle;
+use crate::kernels::math::Real;
+use crate::scene::body::Body;
+use crate::scene::cut::CutReport;
 use crate::scene::settings::Settings;
+use crate::scene::tool::{Tool, ToolLoad};
 
 /// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
 /// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along

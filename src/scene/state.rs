@@ -13,14 +13,14 @@
 //! [`World::state_into`]: crate::World::state_into
 //! [`World::set_state`]: crate::World::set_state
 
-use crate::scene::body::{Body, ParticleState};
-use crate::scene::tool::{Pose, Wrench};
-use crate::scene::cut::CutSets;
 use crate::error::Error;
 use crate::interaction::grasp::Grasp;
-use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::interaction::needle::ShaftHold;
+use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::kernels::parallel::Pool;
+use crate::scene::body::{Body, ParticleState};
+use crate::scene::cut::CutSets;
+use crate::scene::tool::{Pose, Wrench};
 use crate::scene::Scene;
 use std::sync::Arc;
 

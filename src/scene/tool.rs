@@ -372,8 +372,9 @@ impl Tool {
         let aabb = shape.compute_local_aabb();
         let bounding_radius = aabb.center().coords.norm() + aabb.half_extents().norm();
         let spacing = options.sample_spacing.unwrap_or(default_spacing);
-        let (samples, sample_radius) = crate::kernels::collision::sampling::sample_surface(&shape, spacing)
-            .map_err(Error::InvalidArgument)?;
+        let (samples, sample_radius) =
+            crate::kernels::collision::sampling::sample_surface(&shape, spacing)
+                .map_err(Error::InvalidArgument)?;
         Ok(Tool {
             description,
             shape,

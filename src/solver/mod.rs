@@ -19,7 +19,7 @@
 //!    tool samples against the particles; off between a needle and the body it punctured and
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
-//! 3. the divergence check (`crate::divergence`): a failure puts the rollback copy back
+//! 3. the divergence check (`crate::solver::divergence_check`): a failure puts the rollback copy back
 //!    (`Scene::apply_state`, the code `Scene::set_state` uses after its checks);
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
 //!    poses, needle puncture or withdrawal, time.
@@ -33,8 +33,10 @@
 //! hash grid; the surface-contact scratch; the rollback copy); only the prediction (velocities,
 //! rotations) and the final update (`v = (p − x)/h`, `x = p`) write the bodies' state.
 
+mod divergence_check;
 mod organ_contact;
 mod predict;
+pub mod statics;
 mod surface_self_contact;
 mod volume;
 mod workspace;
@@ -43,18 +45,18 @@ pub(crate) use crate::interaction::surface_contact::SurfaceScratch;
 pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
-use crate::scene::body::{volume_on, Body};
-use crate::model::body_model::BodyModel;
-use crate::scene::tool::{Pose, ToolShape, Wrench};
-use crate::scene::cut::{Blade, CutReport};
-use crate::divergence::ParticleScan;
 use crate::error::Error;
+use crate::interaction::{sampled_contact, surface_contact};
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
-use crate::interaction::{sampled_contact, surface_contact};
+use crate::model::body_model::BodyModel;
+use crate::scene::body::{volume_on, Body};
+use crate::scene::cut::{Blade, CutReport};
 use crate::scene::particles::{ParticleView, ParticleViews};
-use crate::scene::{Scene, StepReport, ToolSlot};
 use crate::scene::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
+use crate::scene::tool::{Pose, ToolShape, Wrench};
+use crate::scene::{Scene, StepReport, ToolSlot};
+use crate::solver::divergence_check::ParticleScan;
 use parry3d_f64::math::Point;
 
 /// The bodies' particle views over their step scratch, by body index.
@@ -146,7 +148,7 @@ impl Pipeline {
             .find_map(|(b, ((body, before), scratch))| {
                 let volume = volume_on(&self.pool, &body.state.x, &body.model.boundary);
                 let ratio = volume / body.rest_volume();
-                crate::divergence::diverged(
+                crate::solver::divergence_check::diverged(
                     body,
                     &scratch.scan,
                     ratio,
@@ -379,7 +381,8 @@ impl Pipeline {
         let last = k == n;
         for (body, scratch) in scene.bodies.iter_mut().zip(scratch.iter_mut()) {
             let n = body.state.x.len();
-            let max_speed = crate::divergence::max_speed(body, &scene.settings.divergence);
+            let max_speed =
+                crate::solver::divergence_check::max_speed(body, &scene.settings.divergence);
             let predicted = &scratch.p;
             let state = &mut body.state;
             let (position, velocity) = (

@@ -2,11 +2,11 @@
 //! friction. (Contact of a body with itself is the surface self-contact,
 //! `crate::solver::surface_self_contact`.)
 
-use crate::scene::body::Body;
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::kernels::constraints::contact::project_particle_particle;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
+use crate::scene::body::Body;
 use crate::scene::PairFriction;
 use crate::solver::StepScratch;
 

@@ -1,12 +1,12 @@
 //! Forces and the symplectic prediction of a body for one substep.
 
-use crate::scene::body::{Body, ROTATION_ITERATIONS};
-use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
+use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
+use crate::kernels::tet_elasticity::{self, TetForceInputs};
+use crate::scene::body::{Body, ROTATION_ITERATIONS};
 use crate::scene::settings::ElasticScheme;
 use crate::solver::StepScratch;
-use crate::kernels::tet_elasticity::{self, TetForceInputs};
 
 /// Forces, then the symplectic prediction of one body for a substep `h` (s): velocities into
 /// the body's state, forces and predicted positions into its `scratch`; the elastic forces of

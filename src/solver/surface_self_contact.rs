@@ -53,12 +53,12 @@
 //! vertices in increasing order and the triangles of a cell in boundary order: the same bits
 //! for any thread count.
 
-use crate::scene::body::Body;
-use crate::model::body_model::BodyModel;
+use crate::interaction::surface_contact::MAX_CORNER_SHARE;
 use crate::kernels::collision::triangle_grid::TriangleGrid;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
-use crate::interaction::surface_contact::MAX_CORNER_SHARE;
+use crate::model::body_model::BodyModel;
+use crate::scene::body::Body;
 use crate::solver::StepScratch;
 use parry3d_f64::math::Point;
 use parry3d_f64::query::PointQuery;

@@ -6,11 +6,11 @@
 //! thread count. The dual-cell constraints (one per particle) run the same way, colour by
 //! colour, their cells in place of the blocks.
 
-use crate::scene::body::Body;
 use crate::kernels::constraints::volume::{volume_tet_correction, volume_tet_corrections4};
 use crate::kernels::lanes::{F4, LANES, V4};
 use crate::kernels::math::Real;
 use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
+use crate::scene::body::Body;
 use crate::solver::StepScratch;
 use std::ops::Range;
 

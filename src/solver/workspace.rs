@@ -2,13 +2,13 @@
 //! [`Pipeline`](super::Pipeline) apart from the scene (bodies' model and state, tools), sized
 //! when bodies are added and reused, so that a step allocates nothing.
 
-use crate::scene::body::Body;
-use crate::model::body_model::BodyModel;
 use crate::kernels::collision::hash_grid::HashGrid;
-use crate::divergence::ParticleScan;
 use crate::kernels::math::{Real, Vec3};
+use crate::model::body_model::BodyModel;
+use crate::scene::body::Body;
 use crate::scene::particles::ParticleView;
 use crate::scene::WorldState;
+use crate::solver::divergence_check::ParticleScan;
 use crate::solver::{SelfContactScratch, SurfaceScratch};
 
 /// A body's working memory of a step; nothing in it outlives a substep.

@@ -7,19 +7,19 @@
 mod saved_state;
 mod state;
 
-use crate::scene::body::Body;
-use crate::model::body_model::{BodyModel, BodyOptions};
-use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
-use crate::scene::cut::{Blade, CutReport};
-use crate::scene::derived::DerivedFrom;
 use crate::error::Error;
 use crate::interaction::grasp::{Grasp, GraspOptions};
+use crate::interaction::needle::{Needle, NeedleOptions, NeedleState};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
-use crate::interaction::needle::{Needle, NeedleOptions, NeedleState};
+use crate::model::body_model::{BodyModel, BodyOptions};
 use crate::render::{RenderMesh, RenderSurface};
-use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
+use crate::scene::body::Body;
+use crate::scene::cut::{Blade, CutReport};
+use crate::scene::derived::DerivedFrom;
 use crate::scene::settings::Settings;
+use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
+use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
 use crate::solver::Pipeline;
 use std::sync::Arc;
 
@@ -430,8 +430,8 @@ impl World {
     /// [`SETTLE_TOLERANCE`]: crate::statics::SETTLE_TOLERANCE
     /// [`SETTLE_SPEED`]: crate::statics::SETTLE_SPEED
     /// [`SETTLE_MAX_STEPS`]: crate::statics::SETTLE_MAX_STEPS
-    pub fn settle(&mut self) -> Result<crate::statics::SettleReport, Error> {
-        use crate::statics::{settle_body, SettleReport, SETTLE_MAX_STEPS, SETTLE_SPEED};
+    pub fn settle(&mut self) -> Result<crate::solver::statics::SettleReport, Error> {
+        use crate::solver::statics::{settle_body, SettleReport, SETTLE_MAX_STEPS, SETTLE_SPEED};
         let g = self.scene.settings.gravity;
         let mut settled = self.scene.bodies.clone();
         let (mut newton_iterations, mut relative_residual) = (0, 0.0 as Real);
@@ -491,7 +491,7 @@ impl World {
             speed = (self.scene.bodies.iter().flat_map(|b| b.state.v.iter()))
                 .map(|v| v.norm())
                 .fold(0.0, Real::max);
-            if speed < crate::statics::SETTLE_SPEED {
+            if speed < crate::solver::statics::SETTLE_SPEED {
                 break;
             }
             let kinetic: Real = (self.scene.bodies.iter())
@@ -566,7 +566,7 @@ mod tests {
     fn relaxation_stops_the_stiffest_modes_half_a_substep_back() {
         let (steps, speed) = relax_checkerboard(true).unwrap();
         assert!(
-            speed < crate::statics::SETTLE_SPEED,
+            speed < crate::solver::statics::SETTLE_SPEED,
             "{steps} steps, {speed} m/s"
         );
         // Stopped where they are, the same modes gain amplitude at the stops until the step
@@ -575,7 +575,7 @@ mod tests {
         assert!(
             without
                 .as_ref()
-                .map_or(true, |r| r.1 >= crate::statics::SETTLE_SPEED),
+                .map_or(true, |r| r.1 >= crate::solver::statics::SETTLE_SPEED),
             "{without:?}"
         );
     }

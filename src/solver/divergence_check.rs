@@ -8,8 +8,8 @@
 //! flattened state on purpose recovers through states outside the volume range, and each of
 //! those steps brings it closer.
 
-use crate::scene::body::{volume_of, Body};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
+use crate::scene::body::{volume_of, Body};
 use crate::scene::settings::DivergenceLimits;
 
 /// The particle half of the check over a run of particles: the first particle that is

@@ -20,10 +20,10 @@
 //! derived under (`Derived::from`, the world's settings): the public functions here are given
 //! only a body, and the stiffness must be that of the constants it holds.
 
-use crate::scene::body::Body;
-use crate::kernels::point_elasticity::ElasticModel;
 use crate::error::Error;
 use crate::kernels::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
+use crate::kernels::point_elasticity::ElasticModel;
+use crate::scene::body::Body;
 use crate::scene::settings::{ElasticScheme, VolumeScheme};
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
@@ -164,7 +164,9 @@ pub(crate) fn stiffness(body: &Body, at: Option<&[Vec3]>) -> BlockMatrix {
     for (i, stencil) in particles.iter().enumerate() {
         let vi = body.model.particle_volume[i];
         let r = at.map_or(Mat3::identity(), |x| {
-            polar(crate::kernels::point_elasticity::deformation_gradient(nbr, x, i))
+            polar(crate::kernels::point_elasticity::deformation_gradient(
+                nbr, x, i,
+            ))
         });
         let range = nbr.range(i);
         // ∇u_i = Σ_k u_k c_kᵀ over the stencil: c_i = −Σ_j g_ij, c_j = g_ij.
@@ -261,9 +263,12 @@ fn volume_stiffness_per_unit_volume(body: &Body) -> Real {
 fn energy(body: &Body, x: &[Vec3], g: Vec3) -> Real {
     let model = &body.model;
     let mut e = match body.derived.from.elastic.elastic_scheme {
-        ElasticScheme::PointBased => {
-            crate::kernels::point_elasticity::energy(&body.derived.elastic, &model.nbr, &model.particle_volume, x)
-        }
+        ElasticScheme::PointBased => crate::kernels::point_elasticity::energy(
+            &body.derived.elastic,
+            &model.nbr,
+            &model.particle_volume,
+            x,
+        ),
         ElasticScheme::Tetrahedra => {
             crate::kernels::tet_elasticity::energy(&body.derived.elastic, &model.tet_elements, x)
         }
