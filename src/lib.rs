@@ -24,6 +24,12 @@
 //! ```
 #![warn(missing_docs)]
 
+// The source tree by layer, bottom to top, each importing only the layers below it:
+// `kernels` (arithmetic, threads, stateless kernels) → `model` (what a mesh determines once) →
+// `scene` (what a step advances) → `interaction` (tools on a body's particle view) → `solver`
+// (the step) → `world` (the public API). Beside them: `mesh` (readers and writers), `render`
+// (render surfaces) and `ffi` (the C ABI); `error` is shared by all. docs/ARCHITECTURE.md has
+// the table. Public paths are the re-exports below, not the tree.
 pub(crate) mod error;
 pub mod ffi;
 pub(crate) mod interaction;
@@ -33,15 +39,14 @@ pub(crate) mod model;
 pub mod render;
 pub(crate) mod scene;
 pub(crate) mod solver;
-// The saved-state byte format: public as `tissuesim::state`, in a file whose name says what it
-// holds (the state as a value is `scene::state`).
-#[path = "saved_state.rs"]
-pub mod state;
 pub(crate) mod world;
 
 pub use interaction::{grasp, needle};
 pub use scene::cut;
 pub use solver::statics;
+// The saved-state byte format, public under its historical name (the state as a value is
+// `WorldState`, in `scene::state`).
+pub use world::state_bytes as state;
 
 pub use error::Error;
 pub use interaction::grasp::GraspOptions;

@@ -2,10 +2,12 @@
 //! pipeline that steps it, with the render surfaces bound to its bodies. It builds and queries
 //! the scene, and steps it ([`World::step`]: `solver::Pipeline::step`, Algorithm 1 of the paper,
 //! one pass a file in the `solver` module). Its dynamic state as a value is in [`state`], as
-//! bytes in [`saved_state`].
+//! bytes in [`saved_state`] (`World::save_state`, `restore_state`) over the byte format of
+//! [`state_bytes`] (public as `tissuesim::state`).
 
 mod saved_state;
 mod state;
+pub mod state_bytes;
 
 use crate::error::Error;
 use crate::interaction::grasp::{Grasp, GraspOptions};

@@ -4,7 +4,7 @@
 use super::World;
 use crate::error::Error;
 use crate::scene::WorldState;
-use crate::state::layout_size;
+use crate::world::state_bytes::layout_size;
 
 impl World {
     /// Size in bytes of the state [`World::save_state`] writes now (computed from the world,
