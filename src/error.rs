@@ -1,7 +1,8 @@
-//! The error type of every fallible operation of the library.
+//! The error type of every fallible operation of the library, and [`MeshError`] (public as
+//! `tissuesim::mesh::MeshError`), the error of a mesh reader, which [`Error::Mesh`] carries.
 
-use crate::mesh::MeshError;
 use std::fmt;
+use std::path::{Path, PathBuf};
 
 /// Why an operation failed. Whatever failed left the world as it was.
 ///
@@ -57,6 +58,47 @@ impl std::error::Error for Error {
 impl From<MeshError> for Error {
     fn from(e: MeshError) -> Self {
         Error::Mesh(e)
+    }
+}
+
+/// A mesh that could not be read: the file, the line (1-based) where known, and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshError {
+    /// The file that failed (empty for meshes built from arrays).
+    pub path: PathBuf,
+    /// The 1-based line where the problem was found, when it is tied to one.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+impl MeshError {
+    /// An error in `path` at 1-based `line`.
+    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> Self {
+        MeshError {
+            path: path.to_path_buf(),
+            line: Some(line),
+            message: message.into(),
+        }
+    }
+    /// An error in `path` not tied to a line.
+    pub fn file(path: &Path, message: impl Into<String>) -> Self {
+        MeshError {
+            path: path.to_path_buf(),
+            line: None,
+            message: message.into(),
+        }
     }
 }
 

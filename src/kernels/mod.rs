@@ -8,13 +8,15 @@
 //!   the one-thread order on any number of threads), [`colouring`] (the volume pass's order);
 //! - the point-based method: [`neighbours`] (neighbour search and CSR neighbourhoods),
 //!   [`point_elasticity`] (the force pass), [`stability`] (the explicit stability limit);
-//! - [`tet_elasticity`]: corotated linear tetrahedra, the other force kernel;
+//! - [`tet_elasticity`]: corotated linear tetrahedra, the other force kernel, and [`incidence`]
+//!   (the tetrahedra around each node, for it and the dual cells);
 //! - [`constraints`]: the XPBD/PBD projections (volume, contact, friction);
 //! - [`collision`]: broad phases and geometric queries.
 
 pub(crate) mod collision;
 pub(crate) mod colouring;
 pub(crate) mod constraints;
+pub(crate) mod incidence;
 pub(crate) mod lanes;
 pub(crate) mod math;
 pub(crate) mod neighbours;

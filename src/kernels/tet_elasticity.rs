@@ -81,7 +81,7 @@ impl TetElements {
                 }
             })
             .collect();
-        let (corner_offsets, corners) = crate::mesh::incidence::corners_around(tets, n);
+        let (corner_offsets, corners) = crate::kernels::incidence::corners_around(tets, n);
         TetElements {
             count: tets.len(),
             chunks,

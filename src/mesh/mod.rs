@@ -6,14 +6,12 @@
 //! degenerate ones and unreferenced nodes, and reports what it did in a [`MeshReport`].
 
 use crate::kernels::math::{tet_volume, Real, Vec3};
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod boundary;
 pub(crate) use boundary::boundary_vertices;
 mod clean;
 mod gmsh;
-pub(crate) mod incidence;
 mod lattice;
 mod obj;
 mod organ;
@@ -22,6 +20,7 @@ mod tetgen;
 mod vtk;
 mod vtu;
 
+pub use crate::error::MeshError;
 pub use clean::DEGENERATE_RELATIVE_VOLUME;
 pub use lattice::lattice_box;
 
@@ -48,47 +47,6 @@ pub struct MeshReport {
     pub skipped_elements: usize,
     /// For each node kept, its 0-based position in the file's node list (file order).
     pub original_node_index: Vec<u32>,
-}
-
-/// A mesh that could not be read: the file, the line (1-based) where known, and what is wrong.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MeshError {
-    /// The file that failed (empty for meshes built from arrays).
-    pub path: PathBuf,
-    /// The 1-based line where the problem was found, when it is tied to one.
-    pub line: Option<usize>,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for MeshError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
-        }
-    }
-}
-
-impl std::error::Error for MeshError {}
-
-impl MeshError {
-    /// An error in `path` at 1-based `line`.
-    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> Self {
-        MeshError {
-            path: path.to_path_buf(),
-            line: Some(line),
-            message: message.into(),
-        }
-    }
-    /// An error in `path` not tied to a line.
-    pub fn file(path: &Path, message: impl Into<String>) -> Self {
-        MeshError {
-            path: path.to_path_buf(),
-            line: None,
-            message: message.into(),
-        }
-    }
 }
 
 /// A triangulated surface (an OBJ tool shape): vertices (m) and triangles.

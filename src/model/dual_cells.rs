@@ -40,7 +40,7 @@ impl DualCells {
     /// Panics if a star holds more than 65,535 particles (no tetrahedral mesh comes near).
     pub(crate) fn new(tets: &[[u32; 4]], tet_rest_volume: &[Real], n: usize) -> Self {
         // Each particle's tetrahedra, and its corner among their four (slot 4 t + c).
-        let (offsets, around) = crate::mesh::incidence::corners_around(tets, n);
+        let (offsets, around) = crate::kernels::incidence::corners_around(tets, n);
         let rest_volume = (0..n)
             .map(|i| {
                 let mine = &around[offsets[i] as usize..offsets[i + 1] as usize];
