@@ -13,7 +13,7 @@ pub(crate) use boundary::boundary_vertices;
 mod clean;
 mod gmsh;
 mod lattice;
-mod obj;
+pub(crate) mod obj;
 mod organ;
 pub(crate) mod parse;
 mod tetgen;
