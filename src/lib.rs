@@ -48,9 +48,11 @@ pub use solver::statics;
 // `WorldState`, in `scene::state`).
 pub use world::state_bytes as state;
 
+#[doc(no_inline)]
+pub use cut::{Blade, CutReport};
 pub use error::Error;
-pub use interaction::grasp::GraspOptions;
-pub use interaction::needle::{NeedleOptions, NeedleState};
+#[doc(no_inline)]
+pub use grasp::GraspOptions;
 pub use kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
 pub use kernels::neighbours::MAX_NEIGHBOURS;
 pub use model::body_model::{
@@ -58,8 +60,9 @@ pub use model::body_model::{
     PARTICLE_RADIUS_RANGE, SUPPORT_RADIUS_RANGE, YOUNGS_MODULUS_RANGE,
 };
 pub use model::particle_order::ParticleOrder;
+#[doc(no_inline)]
+pub use needle::{NeedleOptions, NeedleState};
 pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
-pub use scene::cut::{Blade, CutReport};
 pub use scene::settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
 pub use scene::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,

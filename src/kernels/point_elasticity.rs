@@ -116,8 +116,8 @@ pub struct ForceInputs<'a> {
 /// `g_ij` of each of its pairs (+`g_ij` on `i`, −`g_ij` on `j`). The particles are split into
 /// one contiguous share per thread; each share runs its particles in order and scatters each
 /// term to a particle all of whose terms come from the share, and keeps the others for a sum
-/// after a barrier, in the same order ([`crate::kernels::pair_sums`]). Every force is so summed in the
-/// one-thread order: the result is bit-identical for any number of threads. Particles that
+/// after a barrier, in the same order ([`crate::kernels::pair_sums`]). Every force is so summed
+/// in the one-thread order: the result is bit-identical for any number of threads. Particles that
 /// [`ForceInputs::active_before`] leaves out are skipped, four at a time.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_forces(

@@ -6,8 +6,8 @@
 //! `D_m⁻¹`, `D_m = [X_1 - X_0, X_2 - X_0, X_3 - X_0]`, and `b_0 = -(b_1 + b_2 + b_3)`):
 //! 1. `F = Σ_k x_k b_kᵀ = D_s D_m⁻¹` (dimensionless), constant over the tetrahedron;
 //! 2. `R`, the proper rotation maximising `tr(RᵀF)` (inverted `F` handled as for the particles,
-//!    [`crate::kernels::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt rotation of
-//!    `F`'s first two columns and `T` upper triangular, whose own rotation is close to the
+//!    [`crate::kernels::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt
+//!    rotation of `F`'s first two columns and `T` upper triangular, whose own rotation is close to the
 //!    identity unless the tetrahedron is sheared by tens of degrees; Newton from the identity
 //!    on `T` then gives `R = Q R_T` in one to three iterations;
 //! 3. `P = 2μ (F - R) + λ tr(RᵀF - I) R` (Pa), the same corotated stress as the particles'

@@ -7,8 +7,8 @@
 //! A [`BodyModel`] is shared behind an [`Arc`]: every world (or FMU instance) built from the
 //! same mesh and options may hold the same one ([`World::add_body_model`](crate::World::add_body_model)).
 //! What the world's settings and the scene change — the data derived under the settings
-//! (elastic constants, mass scaling: `src/derived.rs`), the fixed particles, the particle state
-//! — lives in [`Body`](crate::Body).
+//! (elastic constants, mass scaling: `src/scene/derived.rs`), the fixed particles, the particle
+//! state — lives in [`Body`](crate::Body).
 //! A cut is the one operation that changes a model; it makes the cut body's own copy first
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 

@@ -110,8 +110,8 @@ pub struct Body {
     /// `active_before[i]`: how many of the particles before `i` are not inert (length:
     /// particles + 1). An inert particle is fixed, and so is every one of its neighbours: its
     /// elastic terms act only on fixed particles, whose forces a step does not use, so the
-    /// step's force pass skips it (`point_elasticity::ForceInputs::active_before`). Follows the fixed
-    /// flags ([`Body::fixed_flags_changed`]).
+    /// step's force pass skips it (`point_elasticity::ForceInputs::active_before`). Follows the
+    /// fixed flags ([`Body::fixed_flags_changed`]).
     pub(crate) active_before: Vec<u32>,
     /// What has been cut, with the load-time data to rebuild from (`None`: never cut).
     pub(crate) cuts: Option<Box<crate::scene::cut::CutState>>,

@@ -25,11 +25,12 @@ pub enum ContactMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ElasticScheme {
     /// The paper's point-based elasticity: a moving-least-squares deformation gradient per
-    /// particle, nodal integration with hourglass control (`crate::kernels::point_elasticity`). The default.
+    /// particle, nodal integration with hourglass control (`crate::kernels::point_elasticity`).
+    /// The default.
     PointBased,
     /// Corotated linear tetrahedra: one deformation gradient and rotation per tetrahedron of
-    /// the mesh, the same corotated stress (`crate::kernels::tet_elasticity`); no zero-energy modes, so
-    /// no hourglass control. The particles stay the unknowns; contact, volume constraints and
+    /// the mesh, the same corotated stress (`crate::kernels::tet_elasticity`); no zero-energy
+    /// modes, so no hourglass control. The particles stay the unknowns; contact, volume constraints and
     /// everything else are unchanged. With the volume constraints on, a crush guard keeps every
     /// tetrahedron above a tenth of its rest volume (a hard one-sided constraint, inactive
     /// above it), so that inverted tetrahedra come back.
@@ -87,7 +88,8 @@ pub struct Settings {
     pub damping_stiffness: Real,
     /// Hourglass-control stiffness (dimensionless, multiplies the shear modulus μ): penalises
     /// the part of each pair's deformation that the particle's deformation gradient does not
-    /// explain (in the spirit of Ganzenmüller 2015; the form in `crate::kernels::point_elasticity`), which suppresses the zero-energy modes of nodal
+    /// explain (in the spirit of Ganzenmüller 2015; the form in
+    /// `crate::kernels::point_elasticity`), which suppresses the zero-energy modes of nodal
     /// integration. Zero for every affine motion, so it never affects the patch test. The
     /// default 0.25 comes from the static study of docs/VALIDATION.md: with the volume
     /// constraints on, the worst error against FEM over two livers and a beam is flat for

@@ -14,12 +14,11 @@
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
 //!    tool contact (each tool against each body, friction, wrench:
-//!    [`surface_contact`](crate::interaction::surface_contact) against the boundary triangles, or
-//!    [`sampled_contact`](crate::interaction::sampled_contact), the paper's
+//!    [`surface_contact`] against the boundary triangles, or [`sampled_contact`], the paper's
 //!    tool samples against the particles; off between a needle and the body it punctured and
 //!    between a grasping tool and the body it holds), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
-//! 3. the divergence check (`crate::solver::divergence_check`): a failure puts the rollback copy back
+//! 3. the divergence check ([`divergence_check`]): a failure puts the rollback copy back
 //!    (`Scene::apply_state`, the code `Scene::set_state` uses after its checks);
 //! 4. grasp slip, blade cuts (`crate::cut`), the tools' wrenches (mean over the substeps) and
 //!    poses, needle puncture or withdrawal, time.

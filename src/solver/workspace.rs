@@ -19,8 +19,8 @@ pub(crate) struct StepScratch {
     /// Forces of the current substep (N).
     pub(crate) force: Vec<Vec3>,
     /// Pair forces of the force pass (N) kept for the particles summed after its barrier
-    /// (`crate::kernels::pair_sums`), one entry per pair slot; empty on one thread, where nothing is
-    /// kept.
+    /// (`crate::kernels::pair_sums`), one entry per pair slot; empty on one thread, where nothing
+    /// is kept.
     pub(crate) pair_force: Vec<Vec3>,
     /// The particles' sums of their pair forces (N), kept as `pair_force` is (one entry per
     /// particle; empty on one thread).
