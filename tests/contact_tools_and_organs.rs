@@ -6,8 +6,8 @@ mod common;
 use common::{bounds, fix_top, liver, tissue, weightless};
 use tissuesim::mesh::{default_organ, lattice_box, TetMesh};
 use tissuesim::{
-    BodyId, BodyOptions, ContactMode, Material, Pose, Quat, Real, Settings, ToolId, ToolOptions,
-    ToolShape, Vec3, World,
+    BodyId, BodyOptions, ContactMode, ElasticScheme, Material, Pose, Quat, Real, Settings, ToolId,
+    ToolOptions, ToolShape, Vec3, VolumeScheme, World,
 };
 
 const G: Real = 9.81;
@@ -201,9 +201,14 @@ fn exact_shape_and_sampled_points_give_press_forces_within_ten_percent() {
 /// A block on a plate tilted by `angle` (rad) about z, friction (μ_s, μ_k). Returns the
 /// distance (m) the block's centre of mass travelled down the slope at each step.
 fn slide(angle: Real, mu_s: Real, mu_k: Real, steps: usize) -> Vec<Real> {
+    slide_with(Settings::default(), angle, mu_s, mu_k, steps)
+}
+
+/// [`slide`] under `settings` (ambient damping off).
+fn slide_with(settings: Settings, angle: Real, mu_s: Real, mu_k: Real, steps: usize) -> Vec<Real> {
     let settings = Settings {
         damping_mass: 0.0,
-        ..Settings::default()
+        ..settings
     };
     let mut world = World::new(settings).unwrap();
     let tilt = Quat::from_axis_angle(&Vec3::z_axis(), angle);
@@ -263,11 +268,13 @@ fn block_sticks_when_the_slope_is_inside_the_static_cone() {
     );
 }
 
-#[test]
-fn block_slides_with_the_kinetic_acceleration() {
+/// Within 2% of `g (sin θ − μ_k cos θ)`: no hidden added mass (the stiff block needs mass
+/// scaling or substeps at dt = 1 ms; mass scaling may add at most 10% of a body's mass, and the
+/// block gets substeps instead where it would need more).
+fn slides_with_the_kinetic_acceleration(settings: Settings) {
     let (mu_s, mu_k) = (0.5, 0.4);
     let angle = (0.7 as Real).atan();
-    let travel = slide(angle, mu_s, mu_k, 600);
+    let travel = slide_with(settings, angle, mu_s, mu_k, 600);
     // Least-squares fit s = s0 + v0 t + a t²/2 over t in [0.2, 0.6] s.
     let samples: Vec<(Real, Real)> = (200..600)
         .map(|k| ((k + 1) as Real * 1e-3, travel[k]))
@@ -276,9 +283,25 @@ fn block_slides_with_the_kinetic_acceleration() {
     let expected = G * (angle.sin() - mu_k * angle.cos());
     println!("sliding acceleration {a:.3} m/s², expected {expected:.3} m/s²");
     assert!(
-        (a - expected).abs() < 0.1 * expected,
+        (a - expected).abs() < 0.02 * expected,
         "acceleration {a} m/s², expected {expected} m/s²"
     );
+}
+
+#[test]
+fn block_slides_with_the_kinetic_acceleration() {
+    slides_with_the_kinetic_acceleration(Settings::default());
+}
+
+/// On corotated tetrahedra the block would need four times its mass at one substep (0.48
+/// instead of 2.41 m/s² before the budget): it takes substeps.
+#[test]
+fn block_on_tetrahedra_slides_with_the_kinetic_acceleration() {
+    slides_with_the_kinetic_acceleration(Settings {
+        elastic_scheme: ElasticScheme::Tetrahedra,
+        volume_scheme: VolumeScheme::DualCells,
+        ..Settings::default()
+    });
 }
 
 /// Acceleration of the least-squares quadratic through `(t, s)` samples.
