@@ -72,6 +72,30 @@ impl F4 {
     pub(crate) fn mul_neg_add(self, m: F4, a: F4) -> F4 {
         F4(self.0.mul_neg_add(m.0, a.0))
     }
+    /// The lanes `[l1, l2, l0, l3]`: a 3-vector in the first three lanes, rotated to y, z, x.
+    /// One permutation with AVX2 (so stored, it is one whole vector), otherwise lane by lane.
+    #[inline(always)]
+    pub(crate) fn rotate_yzx(self) -> F4 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return F4(avx2::permute::<0b11_00_10_01>(self.0));
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        {
+            let [x, y, z, w] = self.to_array();
+            F4::new([y, z, x, w])
+        }
+    }
+    /// The lanes `[l2, l0, l1, l3]`: a 3-vector in the first three lanes, rotated to z, x, y
+    /// (as [`F4::rotate_yzx`]).
+    #[inline(always)]
+    pub(crate) fn rotate_zxy(self) -> F4 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return F4(avx2::permute::<0b11_01_00_10>(self.0));
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        {
+            let [x, y, z, w] = self.to_array();
+            F4::new([z, x, y, w])
+        }
+    }
     /// `(l0 + l1) + (l2 + l3)`.
     #[inline(always)]
     pub(crate) fn sum(self) -> Real {
@@ -459,6 +483,24 @@ mod avx {
                 _mm_storeu_pd(p, _mm256_castpd256_pd128(v));
                 _mm_store_sd(p.add(2), _mm256_extractf128_pd(v, 1));
             }
+        }
+    }
+}
+
+/// Permuting the lanes of one vector with AVX2 (pure data movement).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+mod avx2 {
+    use std::arch::x86_64::{__m256d, _mm256_permute4x64_pd};
+    use wide::f64x4;
+
+    /// Lane `l` of the result is lane `(P >> 2 l) & 3` of `v`.
+    #[inline(always)]
+    pub(super) fn permute<const P: i32>(v: f64x4) -> f64x4 {
+        // SAFETY: AVX2 is enabled for the whole build (the cfg above); `f64x4` is one
+        // `__m256d` in such a build, so the transmutes only rename it.
+        unsafe {
+            let v = std::mem::transmute::<f64x4, __m256d>(v);
+            std::mem::transmute::<__m256d, f64x4>(_mm256_permute4x64_pd::<P>(v))
         }
     }
 }

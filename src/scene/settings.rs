@@ -50,7 +50,7 @@ pub enum VolumeScheme {
     /// the particles' shear it is too soft at ν ≤ 0.45, so not yet the default. Projected
     /// colour by colour on the thread pool (no two cells of a colour share a particle: 31
     /// colours on liver_4k, 26 on the default organ), the same bits on any thread count. Cost,
-    /// haptic liver_4k with the probe: 1.32 ms median per step on one thread against 0.89 ms
+    /// haptic liver_4k with the probe: 1.21 ms median per step on one thread against 0.92 ms
     /// per tetrahedron (docs/PERFORMANCE.md). With `ElasticScheme::Tetrahedra` it is below
     /// linear tetrahedra's static error from ν 0.45 up on every measured mesh.
     DualCells,

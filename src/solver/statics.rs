@@ -23,6 +23,7 @@
 use crate::error::Error;
 use crate::kernels::math::{tet_volume, tet_volume_gradient, Mat3, Real, Vec3};
 use crate::kernels::point_elasticity::ElasticModel;
+use crate::model::dual_cells::CellSlot;
 use crate::scene::body::Body;
 use crate::scene::settings::{ElasticScheme, VolumeScheme};
 use faer::linalg::solvers::Solve;
@@ -225,23 +226,15 @@ fn for_each_volume_term(body: &Body, x: &[Vec3], mut f: impl FnMut(Real, Real, &
         }
         VolumeScheme::DualCells => {
             let cells = &model.dual_cells;
-            let mut relative = vec![Vec3::zeros(); cells.max_star()];
-            let mut cell_gradient = vec![Vec3::zeros(); cells.max_star()];
-            for i in 0..cells.len() {
-                let v0 = cells.rest_volume(i);
-                if v0 > 0.0 {
-                    let v =
-                        cells.volume_and_gradient(i, |k| x[k], &mut relative, &mut cell_gradient);
-                    gradient.clear();
-                    gradient.extend(
-                        cells
-                            .star(i)
-                            .iter()
-                            .copied()
-                            .zip(cell_gradient.iter().copied()),
-                    );
-                    f(v0, v, &gradient);
-                }
+            let mut slots = vec![CellSlot::default(); cells.max_star()];
+            for c in 0..cells.len() {
+                let v = cells
+                    .volume_and_gradient(c, |k| (x[k], 0.0), &mut slots)
+                    .volume;
+                gradient.clear();
+                let star = cells.star(c).iter().zip(&slots);
+                gradient.extend(star.map(|(&k, s)| (k, s.gradient_24() / 24.0)));
+                f(cells.rest_volume(c), v, &gradient);
             }
         }
     }

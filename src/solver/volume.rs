@@ -153,43 +153,38 @@ pub(crate) fn project_dual_cells(body: &Body, scratch: &mut StepScratch, h: Real
     }
     let compliance_per_h2 = body.derived.volume_compliance / (h * h);
     let cells = &body.model.dual_cells;
-    let order = cells.projection_order();
     let star = cells.max_star();
     let p = SharedSlice::new(&mut scratch.p);
-    let lambda = SharedSlice::new(&mut scratch.tet_lambda[..order.len()]);
+    let lambda = SharedSlice::new(&mut scratch.tet_lambda[..cells.len()]);
     let cell_scratch = SharedSlice::new(&mut scratch.cell_scratch);
-    // The cells at `positions` of the projection order, with share `share`'s scratch.
+    // The cells `range` (of the projection order), with share `share`'s scratch.
     // SAFETY (the closure's accesses): within a colour no two cells' stars share a particle,
     // a cell's multiplier is its own (by its position), and each share has its own scratch;
     // a share projects only its cells of the colour, and the shares meet at the barrier before
     // the next colour.
-    let project = |share: usize, positions: Range<usize>| {
-        let mine = unsafe { cell_scratch.range(2 * share * star..2 * (share + 1) * star) };
-        let (relative, gradient) = mine.split_at_mut(star);
-        let lambda = unsafe { lambda.range(positions.clone()) };
-        for (&i, lambda) in order[positions].iter().zip(lambda) {
-            let i = i as usize;
-            let v0 = cells.rest_volume(i);
-            let v = cells.volume_and_gradient(i, |k| *unsafe { p.element(k) }, relative, gradient);
-            let star = cells.star(i);
+    let project = |share: usize, range: Range<usize>| {
+        let slots = unsafe { cell_scratch.range(share * star..(share + 1) * star) };
+        let lambda = unsafe { lambda.range(range.clone()) };
+        for (c, lambda) in range.zip(lambda) {
+            let v0 = cells.rest_volume(c);
+            let particle = |k: usize| (*unsafe { p.element(k) }, body.inv_mass[k]);
+            let cell = cells.volume_and_gradient(c, particle, slots);
             let alpha = compliance_per_h2 * v0;
-            let weight: Real = star
-                .iter()
-                .zip(gradient.iter())
-                .map(|(k, g)| body.inv_mass[*k as usize] * g.norm_squared())
-                .sum();
-            let denominator = weight + alpha;
+            let denominator = cell.weight + alpha;
             if denominator <= 0.0 {
                 continue;
             }
-            let dl = (-(v - v0) - alpha * *lambda) / denominator;
+            let dl = (-(cell.volume - v0) - alpha * *lambda) / denominator;
             *lambda += dl;
-            for (k, g) in star.iter().zip(gradient.iter()) {
-                *unsafe { p.element(*k as usize) } += g * (body.inv_mass[*k as usize] * dl);
+            // Each particle k moves by w_k ∇_k V dl (m).
+            let dl_24 = dl * (1.0 / 24.0);
+            for (&k, slot) in cells.star(c).iter().zip(slots.iter()) {
+                *unsafe { p.element(k as usize) } +=
+                    slot.gradient_24() * (slot.inverse_mass() * dl_24);
             }
         }
     };
-    if pool.threads() == 1 || order.len() < MIN_PARALLEL_CELLS {
+    if pool.threads() == 1 || cells.len() < MIN_PARALLEL_CELLS {
         cells.colours().for_each(|colour| project(0, colour));
         return;
     }

@@ -5,6 +5,7 @@
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::kernels::math::{Real, Vec3};
 use crate::model::body_model::BodyModel;
+use crate::model::dual_cells::CellSlot;
 use crate::scene::body::Body;
 use crate::scene::particles::ParticleView;
 use crate::scene::WorldState;
@@ -27,17 +28,17 @@ pub(crate) struct StepScratch {
     pub(crate) own_force: Vec<Vec3>,
     /// XPBD multipliers of the volume constraints within a substep: one per load-time
     /// tetrahedron, in the colouring's projection order (a cut body uses the first ones), or
-    /// one per dual cell, in the cells' projection order (`DualCells::projection_order`; the
+    /// one per dual cell, in the cells' projection order (`DualCells::colours`; the
     /// array holds the larger count).
     pub(crate) tet_lambda: Vec<Real>,
     /// The corner forces of the tetrahedron force pass (N) kept for the sums after its
     /// barrier, four per load-time tetrahedron (`ElasticScheme::Tetrahedra`; a cut body uses
     /// the first ones); empty on one thread, where they go straight to the particles.
     pub(crate) corner_force: Vec<Vec3>,
-    /// The dual-cell projection's scratch, per thread two runs of the model's largest star:
-    /// the star's positions relative to the cell's particle (m), then the cell volume's
-    /// gradient with respect to each of them (m²).
-    pub(crate) cell_scratch: Vec<Vec3>,
+    /// The dual-cell projection's scratch, per thread a run of the model's largest star: for
+    /// each particle of a cell's star its position relative to the cell's particle (m), its
+    /// inverse mass (1/kg) and the cell volume's gradient with respect to it (m²).
+    pub(crate) cell_scratch: Vec<CellSlot>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
 }
@@ -85,16 +86,17 @@ impl StepScratch {
                 4 * model.tets.len(),
             ),
         };
-        let cell_scratch = 2 * threads * model.dual_cells.max_star();
         for (kept, len) in [
             (&mut self.pair_force, slots),
             (&mut self.own_force, particles),
             (&mut self.corner_force, corners),
-            (&mut self.cell_scratch, cell_scratch),
         ] {
             kept.resize(len, Vec3::zeros());
             kept.shrink_to_fit();
         }
+        let cell_scratch = threads * model.dual_cells.max_star();
+        self.cell_scratch.resize(cell_scratch, CellSlot::default());
+        self.cell_scratch.shrink_to_fit();
     }
 }
 
