@@ -1,11 +1,11 @@
 //! Colouring of the tetrahedra for the volume pass, by blocks. The tetrahedra are put in a
 //! projection order: sorted by their smallest particle index. Particles are numbered along a
 //! Morton curve (`crate::model::particle_order`), so tetrahedra that are neighbours in this
-//! order are neighbours in space. The order is cut into blocks of [`BLOCK`] consecutive tetrahedra, each
-//! working on a compact region of nearby particles, in cache; within a block, consecutive
-//! tetrahedra are made to share no particle where possible (so that one projection does not
-//! wait for the stores of the one before). The blocks are coloured so that
-//! blocks of one colour share no particle. The pass runs the colours in sequence and the
+//! order are neighbours in space. The order is cut into blocks of [`BLOCK`] consecutive
+//! tetrahedra, each working on a compact region of nearby particles, in cache; within a block,
+//! consecutive tetrahedra are made to share no particle where possible (so that one projection
+//! does not wait for the stores of the one before). The blocks are coloured so that blocks of
+//! one colour share no particle. The pass runs the colours in sequence and the
 //! blocks of a colour in any order, on any number of threads, each block's tetrahedra in
 //! their order: the result does not depend on the thread count.
 //!

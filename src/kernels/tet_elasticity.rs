@@ -7,9 +7,9 @@
 //! 1. `F = Σ_k x_k b_kᵀ = D_s D_m⁻¹` (dimensionless), constant over the tetrahedron;
 //! 2. `R`, the proper rotation maximising `tr(RᵀF)` (inverted `F` handled as for the particles,
 //!    [`crate::kernels::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt
-//!    rotation of `F`'s first two columns and `T` upper triangular, whose own rotation is close to the
-//!    identity unless the tetrahedron is sheared by tens of degrees; Newton from the identity
-//!    on `T` then gives `R = Q R_T` in one to three iterations;
+//!    rotation of `F`'s first two columns and `T` upper triangular, whose own rotation is close
+//!    to the identity unless the tetrahedron is sheared by tens of degrees; Newton from the
+//!    identity on `T` then gives `R = Q R_T` in one to three iterations;
 //! 3. `P = 2μ (F - R) + λ tr(RᵀF - I) R` (Pa), the same corotated stress as the particles'
 //!    (`λ = 0` when the volume constraints carry the volumetric stiffness);
 //! 4. the force on corner `k` is `-V P b_k` (N): the exact negative gradient of the energy

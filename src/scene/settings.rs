@@ -30,10 +30,10 @@ pub enum ElasticScheme {
     PointBased,
     /// Corotated linear tetrahedra: one deformation gradient and rotation per tetrahedron of
     /// the mesh, the same corotated stress (`crate::kernels::tet_elasticity`); no zero-energy
-    /// modes, so no hourglass control. The particles stay the unknowns; contact, volume constraints and
-    /// everything else are unchanged. With the volume constraints on, a crush guard keeps every
-    /// tetrahedron above a tenth of its rest volume (a hard one-sided constraint, inactive
-    /// above it), so that inverted tetrahedra come back.
+    /// modes, so no hourglass control. The particles stay the unknowns; contact, volume
+    /// constraints and everything else are unchanged. With the volume constraints on, a crush
+    /// guard keeps every tetrahedron above a tenth of its rest volume (a hard one-sided
+    /// constraint, inactive above it), so that inverted tetrahedra come back.
     Tetrahedra,
 }
 
