@@ -60,6 +60,8 @@ pub(crate) struct MassScalingSettings {
     pub(crate) dt: Real,
     /// Smallest number of substeps per step.
     pub(crate) min_substeps: u32,
+    /// Largest number of substeps per step: the most the budget may ask for.
+    pub(crate) max_substeps: u32,
     /// Fraction of the stability limit `2/ω_max` a substep may use (dimensionless).
     pub(crate) stability_margin: Real,
 }
@@ -90,6 +92,7 @@ impl DerivedFrom {
                 mass_scaling: settings.mass_scaling,
                 dt: settings.dt,
                 min_substeps: settings.min_substeps,
+                max_substeps: settings.max_substeps,
                 stability_margin: settings.stability_margin,
             },
         }
@@ -110,8 +113,13 @@ pub(crate) const TETRAHEDRON_LAMBDA_OVER_MU: Real = 1.5;
 /// 5.6% of its mass, the default organ none); a stiff body whose stability needs more (a 100 kPa
 /// block on corotated tetrahedra needed four times its mass) takes substeps instead, so that no
 /// body moves as if it were more than 10% heavier than it is (a block on a slope slides at the
-/// kinetic-friction acceleration: `tests/contact_tools_and_organs.rs`).
+/// kinetic-friction acceleration: `tests/contact_tools_and_organs.rs`). A body that even
+/// `max_substeps` would not keep within it (the slivers of a poor mesh) gets the scaling it needs
+/// at `min_substeps`, as without the budget.
 pub(crate) const MASS_SCALING_BUDGET: Real = 0.1;
+
+/// Most substep counts whose full mass scaling (power iterations) is tried against the budget.
+const MASS_SCALING_TRIES: usize = 3;
 
 /// A body's data derived from its model and [`DerivedFrom`] (and, after a cut, from its cut
 /// record: [`Derived::restabilise`]).
@@ -190,8 +198,8 @@ impl Derived {
         if !s.mass_scaling {
             return;
         }
-        // The target of `n` substeps a step; `n` from `min_substeps` up until the scaling stays
-        // within the budget (or none is needed).
+        // The target of `n` substeps a step; `n` from `min_substeps` up to `max_substeps` until
+        // the scaling stays within the budget (or none is needed).
         let target = |n: u32| 2.0 * s.stability_margin * n as Real / s.dt;
         let mut n = s.min_substeps;
         if omega <= target(n) {
@@ -206,8 +214,11 @@ impl Derived {
             let added = stiffness.iter().zip(&model.mass);
             added.map(|(k, m)| (2.0 * k / t2 - m).max(0.0)).sum()
         };
-        loop {
-            while omega > target(n) && first_round(n) > MASS_SCALING_BUDGET * total {
+        for _ in 0..MASS_SCALING_TRIES {
+            while n < s.max_substeps
+                && omega > target(n)
+                && first_round(n) > MASS_SCALING_BUDGET * total
+            {
                 n += 1;
             }
             if omega <= target(n) {
@@ -215,12 +226,21 @@ impl Derived {
                 self.omega_max = omega;
                 return;
             }
+            if n == s.max_substeps && first_round(n) > MASS_SCALING_BUDGET * total {
+                break;
+            }
             self.scale_to(model, &stiffness, target(n));
             if !self.over_budget(model) {
                 return;
             }
+            if n == s.max_substeps {
+                break;
+            }
             n += 1;
         }
+        // Not within the budget up to `max_substeps` (the slivers of a poor mesh): the scaling
+        // the body needs at `min_substeps`, as without the budget.
+        self.scale_to(model, &stiffness, target(s.min_substeps));
     }
 
     /// Raise the inertial masses until the estimate is at most `omega_target` (rad/s) (a few
