@@ -5,11 +5,13 @@
 //! `b_0..b_3` (1/m) of its linear shape functions at rest (`b_1, b_2, b_3` the rows of
 //! `D_m⁻¹`, `D_m = [X_1 - X_0, X_2 - X_0, X_3 - X_0]`, and `b_0 = -(b_1 + b_2 + b_3)`):
 //! 1. `F = Σ_k x_k b_kᵀ = D_s D_m⁻¹` (dimensionless), constant over the tetrahedron;
-//! 2. `R`, the proper rotation maximising `tr(RᵀF)` (inverted `F` handled as for the particles,
-//!    [`crate::kernels::rotation`]). It needs no state: `F = Q T` with `Q` the Gram–Schmidt
-//!    rotation of `F`'s first two columns and `T` upper triangular, whose own rotation is close
-//!    to the identity unless the tetrahedron is sheared by tens of degrees; Newton from the
-//!    identity on `T` then gives `R = Q R_T` in one to three iterations;
+//! 2. `R`, the proper rotation maximising `tr(RᵀF)`. It needs no state: Newton's iteration for
+//!    the polar factor, `X₀ = F`, `X_{k+1} = (X_k + X_k⁻ᵀ)/2`, converges quadratically from `F`
+//!    itself (two or three iterations for strains of a few percent), each a cofactor matrix and a
+//!    determinant. An inverted or nearly flat `F`, where that iteration keeps the wrong sign or
+//!    crawls, goes to the inversion-aware extraction of the particles
+//!    ([`crate::kernels::rotation`], started from the Gram–Schmidt rotation of `F`'s first two
+//!    columns; the chunk takes that path only for the lanes that need it);
 //! 3. `P = 2μ (F - R) + λ tr(RᵀF - I) R` (Pa), the same corotated stress as the particles'
 //!    (`λ = 0` when the volume constraints carry the volumetric stiffness);
 //! 4. the force on corner `k` is `-V P b_k` (N): the exact negative gradient of the energy
@@ -35,9 +37,24 @@ use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
 use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 
-/// Newton iterations of a tetrahedron's rotation before the exact SVD fallback (started from
-/// the Gram–Schmidt rotation, they converge in one to three).
+/// Most iterations of the polar Newton iteration (dimensionless). Each squares the distance of
+/// the singular values from 1 (halves it far from 1): a strain of 1% takes three, principal
+/// stretches of 0.3 or 3 five, 0.01 nine.
+const POLAR_ITERATIONS: u32 = 10;
+
+/// Newton iterations of [`rotation_by_quaternion_newton`] before the exact SVD fallback.
 const ROTATION_ITERATIONS: u32 = 8;
+
+/// A polar Newton step shorter than this (dimensionless, Frobenius) ends the iteration: the
+/// convergence is quadratic, so the error left is about half its square (5e-11), below the
+/// particles' [`crate::kernels::rotation::ROTATION_TOLERANCE`] of 1e-10.
+const POLAR_STEP_TOLERANCE: Real = 1.0e-5;
+
+/// `det F` at or below this fraction of `|F|³` (Frobenius; dimensionless) is inverted or nearly
+/// flat: the polar iteration, which keeps the sign of the determinant and needs many steps for
+/// tiny singular values, hands such a tetrahedron to the inversion-aware extraction (`|F|³` is
+/// `3√3` at rest).
+const POLAR_MIN_DETERMINANT: Real = 1.0e-3;
 
 /// The rest data of a body's tetrahedra as elements, built from the model's tetrahedra (and
 /// rebuilt with them by a cut). Laid out four tetrahedra a chunk, one a lane, as the force
@@ -291,10 +308,53 @@ fn chunk_forces(
 }
 
 /// The rotations of the four deformation gradients `f`, without a warm start (see the module
-/// documentation): Newton from the identity on `QᵀF`, `Q` the Gram–Schmidt rotation of `F`'s
-/// first two columns (the identity where they are degenerate).
+/// documentation): Newton's iteration for the polar factor, `X₀ = F`,
+/// `X_{k+1} = (X_k + X_k⁻ᵀ)/2`, each lane until its step `|X_{k+1} − X_k|` (Frobenius) is below
+/// [`POLAR_STEP_TOLERANCE`], then frozen. A lane whose `F` is inverted or nearly flat
+/// (`det F ≤` [`POLAR_MIN_DETERMINANT`] `|F|³`), or that has not converged after
+/// [`POLAR_ITERATIONS`], takes [`rotation_by_quaternion_newton`]'s rotation instead.
 #[inline(always)]
 fn rotation(f: &M4) -> M4 {
+    let columns = |x: &M4| (x.column(0), x.column(1), x.column(2));
+    let (c0, c1, c2) = columns(f);
+    let norm2 = f.inner(f);
+    let det = c0.dot(&c1.cross(&c2));
+    let valid = (F4::splat(POLAR_MIN_DETERMINANT) * norm2 * norm2.sqrt()).lt(det);
+    let tolerance2 = F4::splat(POLAR_STEP_TOLERANCE * POLAR_STEP_TOLERANCE);
+    let mut x = *f;
+    let mut pending = valid;
+    for _ in 0..POLAR_ITERATIONS {
+        if !pending.any() {
+            break;
+        }
+        let (c0, c1, c2) = columns(&x);
+        let (k0, k1, k2) = (c1.cross(&c2), c2.cross(&c0), c0.cross(&c1));
+        // X⁻ᵀ = [c1×c2, c2×c0, c0×c1] / det X, by columns.
+        let half_inverse = F4::splat(0.5) / c0.dot(&k0);
+        let next = x
+            .scale(F4::splat(0.5))
+            .add(&M4::from_columns(&k0, &k1, &k2).scale(half_inverse));
+        let change = next.add(&x.scale(F4::splat(-1.0)));
+        x = M4::select(pending, &next, &x);
+        pending = pending & !change.inner(&change).lt(tolerance2);
+    }
+    let inverted = !valid | pending;
+    if inverted.any() {
+        x = M4::select(inverted, &rotation_by_quaternion_newton(f), &x);
+    }
+    x
+}
+
+/// The rotations of the four deformation gradients `f` by the inversion-aware extraction of
+/// [`crate::kernels::rotation`]: Newton from the identity on `QᵀF`, `Q` the Gram–Schmidt
+/// rotation of `F`'s first two columns (the identity where they are degenerate), the exact SVD
+/// where that does not converge. For an inverted tetrahedron `Q` keeps the orientation of the
+/// face of corners 0, 1, 2 and finds the fourth corner on the wrong side of it: a mirrored
+/// tetrahedron, whose singular values are all 1 and leave the SVD's choice arbitrary, is pushed
+/// back through that face.
+#[cold]
+#[inline(never)]
+fn rotation_by_quaternion_newton(f: &M4) -> M4 {
     let (c0, c1) = (f.column(0), f.column(1));
     let tiny = F4::splat(1.0e-24) * f.inner(f);
     let n0 = c0.dot(&c0);
@@ -388,6 +448,47 @@ mod tests {
         rest.iter()
             .map(|p| rot * Vec3::new(1.3 * p.x + 0.2 * p.y, 0.8 * p.y + 0.1 * p.z * p.z, p.z))
             .collect()
+    }
+
+    /// The polar iteration gives the rotation the SVD gives (the proper rotation maximising
+    /// `tr(RᵀF)`) for small strains, large stretches and compressions and nearly flat gradients
+    /// (handed over), in mixed chunks; for inverted ones (handed over) a proper rotation with
+    /// `RᵀF` symmetric, so that the corner forces have no torque.
+    #[test]
+    fn the_rotation_is_the_svds_in_every_regime() {
+        let turn = |axis: Vec3, angle: Real| {
+            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle)
+                .into_inner()
+        };
+        let stretch = |a: Real, b: Real, c: Real| Mat3::from_diagonal(&Vec3::new(a, b, c));
+        let shear = Mat3::new(1.0, 0.3, -0.2, 0.05, 1.0, 0.4, 0.0, -0.1, 1.0);
+        let gradients = [
+            turn(Vec3::new(1.0, 2.0, 3.0), 0.7) * (Mat3::identity() + 1e-3 * shear),
+            turn(Vec3::new(-1.0, 0.5, 0.2), 2.9) * stretch(0.3, 1.0, 3.0),
+            turn(Vec3::new(0.0, 1.0, 1.0), 1.2) * shear * stretch(0.02, 1.5, 1.0),
+            turn(Vec3::new(0.3, -1.0, 0.4), 0.4) * stretch(1e-4, 1.0, 1.0),
+            turn(Vec3::new(2.0, 1.0, 0.0), 1.0) * stretch(-0.2, 1.1, 0.9),
+            turn(Vec3::new(1.0, 0.0, 0.0), 3.1) * shear * stretch(1.0, -1.0, 1.0),
+            Mat3::identity(),
+            shear,
+        ];
+        for chunk in gradients.chunks(LANES) {
+            let r = rotation(&M4::from_matrices(&std::array::from_fn(|l| chunk[l])));
+            for (l, f) in chunk.iter().enumerate() {
+                let got = r.lane(l);
+                if f.determinant() < 0.0 {
+                    let asymmetry = got.transpose() * f - f.transpose() * got;
+                    assert!((got.transpose() * got - Mat3::identity()).norm() < 1e-12);
+                    assert!((got.determinant() - 1.0).abs() < 1e-12 && asymmetry.norm() < 1e-9);
+                    continue;
+                }
+                let expected = rotation_from_svd(f).to_rotation_matrix().into_inner();
+                assert!(
+                    (got - expected).norm() < 1e-9,
+                    "F = {f}: rotation {got}, the SVD's {expected}"
+                );
+            }
+        }
     }
 
     #[test]
