@@ -37,6 +37,11 @@ use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
 use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 
+/// The force pass reports the tetrahedra whose volume is below this fraction of their rest
+/// volume (dimensionless; their `det F`): the list the crush guard of the solver's volume pass
+/// checks, five times its floor, so that a tetrahedron it lifted to the floor stays on it.
+pub(crate) const COMPRESSED_RATIO: Real = 0.5;
+
 /// Most iterations of the polar Newton iteration (dimensionless). Each squares the distance of
 /// the singular values from 1 (halves it far from 1): a strain of 1% takes three, principal
 /// stretches of 0.3 or 3 five, 0.01 nine.
@@ -140,17 +145,6 @@ impl TetElements {
         self.chunks.len()
     }
 
-    /// The volume ratios `V/V₀` (dimensionless) at positions `x` (m) of the tetrahedra
-    /// `4 c .. 4 c + 4` (chunk `c`; a padded lane repeats the chunk's last tetrahedron).
-    pub(crate) fn chunk_volume_ratios(&self, c: usize, x: &[Vec3]) -> [Real; LANES] {
-        let chunk = &self.chunks[c];
-        let corner = |k: usize| V4::from_refs(chunk.tets.each_ref().map(|tet| &x[tet[k] as usize]));
-        let origin = corner(0);
-        let (e1, e2, e3) = (corner(1) - origin, corner(2) - origin, corner(3) - origin);
-        let six_volume = e1.dot(&e2.cross(&e3));
-        (six_volume / (F4::splat(6.0) * chunk.volume)).to_array()
-    }
-
     /// The deformation gradient (dimensionless) of tetrahedron `t` at positions `x` (m).
     pub(crate) fn deformation_gradient(&self, t: usize, x: &[Vec3]) -> Mat3 {
         let (tet, dinv) = self.element(t);
@@ -189,7 +183,10 @@ pub(crate) struct TetForceInputs<'a> {
 
 /// Add every tetrahedron's elastic (and damping) forces (N) to `force`, one per particle.
 /// `corner_force` is scratch with four entries per tetrahedron, used on several threads only
-/// (it may be empty on one): nothing is allocated.
+/// (it may be empty on one): nothing is allocated. Unless `compressed` is empty (one entry per
+/// chunk of four tetrahedra, [`TetElements::chunk_count`]), bit `l` of chunk `c`'s entry is set
+/// where tetrahedron `4 c + l` is below [`COMPRESSED_RATIO`] of its rest volume at `x`, from
+/// the pass's own `det F` (a chunk whose corners are all fixed reads 0).
 ///
 /// On one thread each chunk's corner forces go straight to the particles, chunk after chunk;
 /// on several, each share of the chunks writes its corner slots, and after a barrier each
@@ -199,6 +196,7 @@ pub(crate) fn accumulate_forces(
     model: &ElasticModel,
     input: &TetForceInputs<'_>,
     corner_force: &mut [Vec3],
+    compressed: &mut [u8],
     force: &mut [Vec3],
     pool: &Pool,
 ) {
@@ -206,6 +204,15 @@ pub(crate) fn accumulate_forces(
     let (m, n) = (elements.count, force.len());
     assert!(elements.corner_offsets.len() == n + 1 && input.x.len() == n);
     assert!(input.v.len() == n && (input.fixed.is_empty() || input.fixed.len() == n));
+    let report = !compressed.is_empty();
+    assert!(!report || compressed.len() >= elements.chunks.len());
+    // The chunk's bits of the tetrahedra (not its padding) below the floor.
+    let compressed_bits = |c: usize, ratio: F4| {
+        let below = ratio.lt(F4::splat(COMPRESSED_RATIO));
+        (0..LANES.min(m - LANES * c))
+            .filter(|&l| below.lane(l))
+            .fold(0u8, |bits, l| bits | 1 << l)
+    };
     let chunks = &elements.chunks;
     let inert = |chunk: &TetChunk| {
         !input.fixed.is_empty()
@@ -216,8 +223,17 @@ pub(crate) fn accumulate_forces(
                 .all(|&k| input.fixed[k as usize])
     };
     if pool.threads() == 1 {
-        for (c, chunk) in chunks.iter().enumerate().filter(|(_, c)| !inert(c)) {
-            let corners = chunk_forces(model, input, chunk);
+        for (c, chunk) in chunks.iter().enumerate() {
+            if inert(chunk) {
+                if report {
+                    compressed[c] = 0;
+                }
+                continue;
+            }
+            let (corners, ratio) = chunk_forces(model, input, chunk);
+            if report {
+                compressed[c] = compressed_bits(c, ratio);
+            }
             for (l, tet) in chunk.tets.iter().enumerate().take(m - LANES * c) {
                 for (corner, &k) in corners.iter().zip(tet) {
                     force[k as usize] += corner[l];
@@ -231,19 +247,31 @@ pub(crate) fn accumulate_forces(
         "the corner slots are sized for several threads"
     );
     let slots = SharedSlice::new(&mut corner_force[..4 * m]);
+    let compressed = SharedSlice::new(compressed);
     let forces = SharedSlice::new(force);
     let barrier = Barrier::new(pool.threads());
     pool.run(&|share| {
         let _guard = barrier.guard();
         let mine = pool.share(share, chunks.len());
         let (first, last) = (LANES * mine.start, (LANES * mine.end).min(m));
-        // SAFETY: the shares' chunks, hence their tetrahedra's corner slots, are disjoint.
+        // SAFETY: the shares' chunks, hence their tetrahedra's corner slots and their
+        // entries of `compressed`, are disjoint.
         let out = unsafe { slots.range(4 * first..4 * last) };
-        for (chunk, out) in chunks[mine].iter().zip(out.chunks_mut(4 * LANES)) {
+        let flags = unsafe { compressed.range(if report { mine.clone() } else { 0..0 }) };
+        for (c, (chunk, out)) in mine
+            .clone()
+            .zip(chunks[mine.clone()].iter().zip(out.chunks_mut(4 * LANES)))
+        {
             if inert(chunk) {
+                if report {
+                    flags[c - mine.start] = 0;
+                }
                 continue;
             }
-            let corners = chunk_forces(model, input, chunk);
+            let (corners, ratio) = chunk_forces(model, input, chunk);
+            if report {
+                flags[c - mine.start] = compressed_bits(c, ratio);
+            }
             for (l, out) in out.chunks_mut(4).enumerate() {
                 for (slot, corner) in out.iter_mut().zip(&corners) {
                     *slot = corner[l];
@@ -265,13 +293,14 @@ pub(crate) fn accumulate_forces(
     });
 }
 
-/// The corner forces (N) of the four tetrahedra of `chunk`: `[corner][lane]`.
+/// The corner forces (N) of the four tetrahedra of `chunk`, `[corner][lane]`, and their volume
+/// ratios `det F` (dimensionless).
 #[inline(always)]
 fn chunk_forces(
     model: &ElasticModel,
     input: &TetForceInputs<'_>,
     chunk: &TetChunk,
-) -> [[Vec3; LANES]; 4] {
+) -> ([[Vec3; LANES]; 4], F4) {
     let corner = |field: &[Vec3], c: usize| {
         V4::from_refs(chunk.tets.each_ref().map(|tet| &field[tet[c] as usize]))
     };
@@ -286,7 +315,9 @@ fn chunk_forces(
         f
     };
     let f = gradient(input.x);
-    let r = rotation(&f);
+    let (c0, c1, c2) = (f.column(0), f.column(1), f.column(2));
+    let det = c0.dot(&c1.cross(&c2));
+    let r = rotation(&f, det);
     let mut p = corotated_stress(&f, &r, model.lambda, model.mu);
     if model.damping_stiffness != 0.0 {
         let rate = r.transpose().mul_mat(&gradient(input.v));
@@ -304,21 +335,19 @@ fn chunk_forces(
     for (k, g) in g.iter().enumerate() {
         (-*g).store(&mut out[k + 1]);
     }
-    out
+    (out, det)
 }
 
-/// The rotations of the four deformation gradients `f`, without a warm start (see the module
-/// documentation): Newton's iteration for the polar factor, `X₀ = F`,
+/// The rotations of the four deformation gradients `f` of determinants `det`, without a warm
+/// start (see the module documentation): Newton's iteration for the polar factor, `X₀ = F`,
 /// `X_{k+1} = (X_k + X_k⁻ᵀ)/2`, each lane until its step `|X_{k+1} − X_k|` (Frobenius) is below
 /// [`POLAR_STEP_TOLERANCE`], then frozen. A lane whose `F` is inverted or nearly flat
 /// (`det F ≤` [`POLAR_MIN_DETERMINANT`] `|F|³`), or that has not converged after
 /// [`POLAR_ITERATIONS`], takes [`rotation_by_quaternion_newton`]'s rotation instead.
 #[inline(always)]
-fn rotation(f: &M4) -> M4 {
+fn rotation(f: &M4, det: F4) -> M4 {
     let columns = |x: &M4| (x.column(0), x.column(1), x.column(2));
-    let (c0, c1, c2) = columns(f);
     let norm2 = f.inner(f);
-    let det = c0.dot(&c1.cross(&c2));
     let valid = (F4::splat(POLAR_MIN_DETERMINANT) * norm2 * norm2.sqrt()).lt(det);
     let tolerance2 = F4::splat(POLAR_STEP_TOLERANCE * POLAR_STEP_TOLERANCE);
     let mut x = *f;
@@ -438,7 +467,29 @@ mod tests {
         };
         let mut slots = vec![Vec3::zeros(); 4 * tets.len()];
         let mut force = vec![Vec3::zeros(); x.len()];
-        accumulate_forces(model, &input, &mut slots, &mut force, &Pool::new(threads));
+        let mut compressed = vec![0xff; elements.chunk_count()];
+        let pool = Pool::new(threads);
+        accumulate_forces(
+            model,
+            &input,
+            &mut slots,
+            &mut compressed,
+            &mut force,
+            &pool,
+        );
+        // The reported tetrahedra are exactly those below the floor.
+        let current = volumes(x, tets);
+        let expected = current
+            .iter()
+            .zip(elements.chunks.iter().flat_map(|c| c.volume.to_array()))
+            .map(|(v, v0)| v / v0 < COMPRESSED_RATIO);
+        for (t, below) in expected.enumerate() {
+            assert_eq!(
+                compressed[t / LANES] & 1 << (t % LANES) != 0,
+                below,
+                "tetrahedron {t}"
+            );
+        }
         force
     }
 
@@ -473,7 +524,9 @@ mod tests {
             shear,
         ];
         for chunk in gradients.chunks(LANES) {
-            let r = rotation(&M4::from_matrices(&std::array::from_fn(|l| chunk[l])));
+            let f = M4::from_matrices(&std::array::from_fn(|l| chunk[l]));
+            let det = F4::new(std::array::from_fn(|l| chunk[l].determinant()));
+            let r = rotation(&f, det);
             for (l, f) in chunk.iter().enumerate() {
                 let got = r.lane(l);
                 if f.determinant() < 0.0 {
@@ -586,6 +639,15 @@ mod tests {
         x[k] = d - n * (2.0 * n.dot(&(d - a)));
         let zero = vec![Vec3::zeros(); x.len()];
         let f = forces(&model, &rest, &tet, &x, &zero, 1);
+        assert!(
+            crate::kernels::math::tet_volume(
+                &x[tet[0][0] as usize],
+                &x[tet[0][1] as usize],
+                &x[tet[0][2] as usize],
+                &x[k]
+            ) < 0.0,
+            "inverted, so reported as compressed (checked in `forces`)"
+        );
         // Back through the plane, towards the side corner 3 came from.
         assert!(f[k].dot(&n) * n.dot(&(d - a)) > 0.0, "{}", f[k]);
     }

@@ -339,6 +339,7 @@ impl Derived {
                 &self.elastic,
                 &input,
                 &mut [],
+                &mut [],
                 &mut force,
                 &Pool::new(1),
             );

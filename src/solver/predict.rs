@@ -70,6 +70,7 @@ pub(crate) fn predict(
                 fixed: &body.fixed,
             },
             &mut scratch.corner_force,
+            &mut scratch.compressed,
             &mut scratch.force,
             pool,
         ),

@@ -209,29 +209,25 @@ fn each_lane<T>(mut f: impl FnMut(usize) -> T) -> [T; LANES] {
 /// Least volume (in rest volumes, dimensionless) the crush guard keeps a tetrahedron at.
 pub(crate) const CRUSH_FLOOR_RATIO: Real = 0.1;
 
-/// The crush guard of `ElasticScheme::Tetrahedra`: every tetrahedron whose volume on the
-/// predicted positions is below [`CRUSH_FLOOR_RATIO`] of its rest volume is projected back to
-/// that, as a hard one-sided constraint. The corotated elements push an inverted tetrahedron
-/// back only weakly (where two singular values of `F` sum to zero its rotation, hence its
-/// force, jumps), and with the volumetric stiffness on the dual cells nothing else does:
-/// after a mirroring, inverted tetrahedra flapped for seconds. The guard is inactive in any
-/// deformation that keeps every tetrahedron above a tenth of its volume, so it adds no
-/// stiffness there (no locking). The volumes are taken four tetrahedra at a time and the few
-/// below the floor projected one by one, on the calling thread in tetrahedron order (a
-/// tetrahedron is checked against the positions before the projections of the others of its
-/// four; one pushed under the floor by them is caught in the next pass).
+/// The crush guard of `ElasticScheme::Tetrahedra`: every tetrahedron that the substep's force
+/// pass found below [`CRUSH_FLOOR_RATIO`] of its rest volume (at the positions the substep
+/// started from, `StepScratch::crushed`) and that is still below it on the predicted positions
+/// is projected back to that, as a hard one-sided constraint. The corotated elements push an
+/// inverted tetrahedron back only weakly (where two singular values of `F` sum to zero its
+/// rotation, hence its force, jumps), and with the volumetric stiffness on the dual cells
+/// nothing else does: after a mirroring, inverted tetrahedra flapped for seconds. The guard is
+/// inactive in any deformation that keeps every tetrahedron above a tenth of its volume, so it
+/// adds no stiffness there (no locking). Its list costs nothing (the force pass forms every
+/// `det F`); a tetrahedron that goes from above half its volume to below a tenth within one
+/// substep is lifted at the end of the next one, and one lifted to the floor stays listed.
+/// The listed tetrahedra are projected one by one, on the calling thread in tetrahedron order.
 pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) {
-    let model = &body.model;
-    let elements = &model.tet_elements;
+    let elements = &body.model.tet_elements;
     let p = &mut scratch.p;
-    let count = elements.len();
-    for c in 0..elements.chunk_count() {
-        let ratios = elements.chunk_volume_ratios(c, p);
-        for (l, ratio) in ratios.iter().enumerate() {
+    let chunks = elements.chunk_count();
+    for (c, &bits) in scratch.compressed[..chunks].iter().enumerate() {
+        for l in (0..LANES).filter(|l| bits & 1 << l != 0) {
             let t = LANES * c + l;
-            if *ratio >= CRUSH_FLOOR_RATIO || t >= count {
-                continue;
-            }
             let corners = elements.corners(t).map(|k| k as usize);
             let x = corners.map(|k| p[k]);
             let w = corners.map(|k| body.inv_mass[k]);

@@ -35,6 +35,11 @@ pub(crate) struct StepScratch {
     /// barrier, four per load-time tetrahedron (`ElasticScheme::Tetrahedra`; a cut body uses
     /// the first ones); empty on one thread, where they go straight to the particles.
     pub(crate) corner_force: Vec<Vec3>,
+    /// The tetrahedra the force pass found below half their rest volume at the substep's start
+    /// (`kernels::tet_elasticity::COMPRESSED_RATIO`), one bit a tetrahedron, one entry per
+    /// chunk of four (`ElasticScheme::Tetrahedra`; sized for the load-time tetrahedra, a cut
+    /// body uses the first ones): the ones the crush guard checks.
+    pub(crate) compressed: Vec<u8>,
     /// The dual-cell projection's scratch, per thread a run of the model's largest star: for
     /// each particle of a cell's star its position relative to the cell's particle (m), its
     /// inverse mass (1/kg) and the cell volume's gradient with respect to it (m²).
@@ -54,6 +59,7 @@ impl StepScratch {
             own_force: Vec::new(),
             tet_lambda: vec![0.0; model.tets.len().max(n)],
             corner_force: Vec::new(),
+            compressed: vec![0; model.tet_elements.chunk_count()],
             cell_scratch: Vec::new(),
             scan: ParticleScan::EMPTY,
         };
