@@ -10,7 +10,6 @@ mod state;
 pub mod state_bytes;
 
 use crate::error::Error;
-use crate::interaction::needle::{Needle, NeedleOptions, NeedleState};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::model::body_model::{BodyModel, BodyOptions};
@@ -19,6 +18,7 @@ use crate::scene::body::Body;
 use crate::scene::cut::{Blade, CutReport};
 use crate::scene::derived::DerivedFrom;
 use crate::scene::grasp_state::{Grasp, GraspOptions};
+use crate::scene::needle_state::{Needle, NeedleOptions, NeedleState};
 use crate::scene::settings::Settings;
 use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
