@@ -13,103 +13,17 @@
 //! jaws enclose the tissue, and contact would fight the attachments);
 //! [`World::release`](crate::World::release) lets go and contact acts again.
 
-use crate::error::{check_finite, Error};
+use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
 use crate::scene::body::Body;
+// The grasp's data (its options, the attachments) is in the scene layer, whose tool slots and
+// `WorldState` hold it; this file is what a grasp does with it.
+use crate::scene::grasp_state::{Attachment, Grasp};
 use crate::scene::particles::ParticleViews;
 use crate::scene::tool::{Pose, Tool, ToolLoad};
 use parry3d_f64::math::Point;
 
-/// How a tool grasps.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GraspOptions {
-    /// Particles whose centre is within this distance (m) of the tool's surface (or inside it)
-    /// are grasped. `None`: 1.5 × the body's particle radius (three quarters of the mean edge by
-    /// default) — the corners of the surface triangles the tool touches and none of the layer
-    /// of particles behind them.
-    pub reach: Option<Real>,
-    /// Compliance of each attachment (m/N; 0 = rigid). `None`: `1 / (E r)`, the compliance of a
-    /// cube of the body's tissue one particle radius `r` across (E its Young's modulus), so the
-    /// jaws hold as firmly as the tissue around them.
-    pub compliance: Option<Real>,
-    /// Largest total force (N) the attachments may exert on the tool; beyond it the tissue slips
-    /// and every attachment is released. Infinity (the default) never slips.
-    pub max_force: Real,
-}
-
-impl Default for GraspOptions {
-    fn default() -> Self {
-        GraspOptions {
-            reach: None,
-            compliance: None,
-            max_force: Real::INFINITY,
-        }
-    }
-}
-
-impl GraspOptions {
-    /// Check the options: `reach` and `compliance` finite and ≥ 0 when given, `max_force` > 0
-    /// (infinity allowed). NaN gives [`Error::NonFinite`], other bad values
-    /// [`Error::InvalidArgument`].
-    pub fn validate(&self) -> Result<(), Error> {
-        for (name, v) in [
-            ("grasp reach", self.reach),
-            ("grasp compliance", self.compliance),
-        ] {
-            if let Some(v) = v {
-                check_finite(name, v)?;
-                if v < 0.0 {
-                    return Err(Error::InvalidArgument(format!(
-                        "{name} must be >= 0, got {v}"
-                    )));
-                }
-            }
-        }
-        if self.max_force.is_nan() {
-            return Err(Error::NonFinite("grasp max_force is NaN".into()));
-        }
-        if self.max_force <= 0.0 {
-            return Err(Error::InvalidArgument(format!(
-                "grasp max_force must be > 0 N (infinity: never slips), got {}",
-                self.max_force
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// One grasped particle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Attachment {
-    pub(crate) body: u32,
-    pub(crate) particle: u32,
-    /// Where the particle is held, in the tool's frame (m).
-    pub(crate) anchor: Vec3,
-    /// Compliance (m/N).
-    pub(crate) compliance: Real,
-    /// XPBD multiplier of the substep in progress (N·s²).
-    pub(crate) lambda: Vec3,
-}
-
-/// The attachments of one tool and its slip limit.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Grasp {
-    pub(crate) attachments: Vec<Attachment>,
-    pub(crate) max_force: Real,
-    /// Σ m Δx of the attachments over the step in progress (kg·m).
-    pub(crate) acc_impulse: Vec3,
-}
-
-impl Default for Grasp {
-    /// Not grasping.
-    fn default() -> Self {
-        Grasp {
-            attachments: Vec::new(),
-            max_force: Real::INFINITY,
-            acc_impulse: Vec3::zeros(),
-        }
-    }
-}
+pub use crate::scene::grasp_state::GraspOptions;
 
 impl Grasp {
     /// Whether any particle of body `b` is held: contact between the tool and that body is then

@@ -9,7 +9,9 @@
 //! - [`needle`]: puncture, and tissue held on a needle's shaft with axial friction.
 //!
 //! The contacts between bodies and of a body with itself need the solver's broad phases and
-//! stay in [`crate::solver`]. Grasps and needle holds keep their state in the scene's tool slots.
+//! stay in [`crate::solver`]. Grasps and needles keep their data in the scene's tool slots, as
+//! the types of [`crate::scene::grasp_state`] and [`crate::scene::needle_state`] (the public
+//! ones re-exported by [`grasp`] and [`needle`]); the files here hold what they do.
 
 pub mod grasp;
 pub mod needle;

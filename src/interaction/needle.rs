@@ -22,101 +22,17 @@
 //! the tip withdraws past are let go; once the tip is back behind the entry point the needle is
 //! out and contact acts again.
 
-use crate::error::{check_finite, Error};
+use crate::error::Error;
 use crate::kernels::math::{Real, Vec3};
 use crate::scene::body::Body;
+// The needle's data (options, shaft, insertion, holds) is in the scene layer, whose tool slots
+// and `WorldState` hold it; this file is what a needle does with it.
+use crate::scene::needle_state::{Needle, ShaftHold};
 use crate::scene::particles::ParticleViews;
 use crate::scene::tool::{Pose, Tool, ToolLoad, ToolShape};
 use parry3d_f64::math::Point;
 
-/// How a needle punctures and holds the tissue.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NeedleOptions {
-    /// Axial force (N) the tissue must exert on the tip for the needle to puncture it (a
-    /// property of the tissue and the needle; liver and a 1 mm needle: ~0.5–1.5 N).
-    pub puncture_force: Real,
-    /// Axial friction force per inserted length (N/m) once punctured.
-    pub friction_per_length: Real,
-    /// Particles whose centre comes within this distance (m) of the inserted shaft's axis are
-    /// held. `None`: the needle's radius plus 1.5 particle radii (the particles contact had
-    /// placed around it).
-    pub reach: Option<Real>,
-}
-
-impl Default for NeedleOptions {
-    fn default() -> Self {
-        NeedleOptions {
-            puncture_force: 1.0,
-            friction_per_length: 20.0,
-            reach: None,
-        }
-    }
-}
-
-impl NeedleOptions {
-    /// Check the options: `puncture_force` > 0, `friction_per_length` ≥ 0, `reach` > 0 when
-    /// given; all finite ([`Error::NonFinite`] otherwise).
-    pub fn validate(&self) -> Result<(), Error> {
-        check_finite("needle puncture_force", self.puncture_force)?;
-        check_finite("needle friction_per_length", self.friction_per_length)?;
-        let bad = |m: String| Err(Error::InvalidArgument(m));
-        if self.puncture_force <= 0.0 {
-            return bad(format!(
-                "needle puncture_force must be > 0 N, got {}",
-                self.puncture_force
-            ));
-        }
-        if self.friction_per_length < 0.0 {
-            return bad(format!(
-                "needle friction_per_length must be >= 0 N/m, got {}",
-                self.friction_per_length
-            ));
-        }
-        if let Some(r) = self.reach {
-            check_finite("needle reach", r)?;
-            if r <= 0.0 {
-                return bad(format!("needle reach must be > 0 m, got {r}"));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Where a needle is: [`World::needle_state`](crate::World::needle_state).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NeedleState {
-    /// Whether the needle is in the tissue.
-    pub punctured: bool,
-    /// How far the tip is past the entry point along the shaft (m; 0 when not punctured).
-    pub inserted_length: Real,
-    /// Number of particles held on the shaft.
-    pub held: usize,
-}
-
-/// One particle held on the shaft.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ShaftHold {
-    pub(crate) particle: u32,
-    /// Where the particle is held, in the needle's frame (m): x and z lateral, y axial.
-    pub(crate) anchor: Vec3,
-    /// XPBD multiplier of the lateral constraint, this substep (N·s²).
-    pub(crate) lambda: Vec3,
-}
-
-/// The needle state of a tool.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Needle {
-    pub(crate) options: NeedleOptions,
-    /// Distance (m) from the tool origin to the tip along local +y.
-    pub(crate) tip: Real,
-    /// Radius of the shaft (m).
-    pub(crate) radius: Real,
-    /// The punctured body, if any.
-    pub(crate) body: Option<u32>,
-    /// Where the tip entered the tissue (m, world frame).
-    pub(crate) entry: Vec3,
-    pub(crate) holds: Vec<ShaftHold>,
-}
+pub use crate::scene::needle_state::{NeedleOptions, NeedleState};
 
 impl Needle {
     /// A needle made of `tool`, which must be a capsule or a cylinder.

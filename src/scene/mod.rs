@@ -9,12 +9,16 @@
 //! Beside it, what the scene is made of: [`body`] (a body in a world: its model, derived data,
 //! fixed particles and particle state), [`derived`] (what a body derives from the settings and
 //! its model), [`settings`] (`Settings`), [`tool`] (the tools: shapes, poses, wrench),
-//! [`particles`] (the narrow view of a body that the interactions act on) and [`cut`] (a body's
-//! topology changed by a blade, and restored from a saved state's cut sets).
+//! [`grasp_state`] and [`needle_state`] (the data of a tool's grasp and needle; what they do is
+//! in [`crate::interaction`]), [`particles`] (the narrow view of a body that the interactions
+//! act on) and [`cut`] (a body's topology changed by a blade, and restored from a saved state's
+//! cut sets).
 
 pub(crate) mod body;
 pub mod cut;
 pub(crate) mod derived;
+pub(crate) mod grasp_state;
+pub(crate) mod needle_state;
 pub(crate) mod particles;
 pub(crate) mod settings;
 pub(crate) mod state;
@@ -23,11 +27,11 @@ pub(crate) mod tool;
 pub use state::WorldState;
 
 use crate::error::Error;
-use crate::interaction::grasp::Grasp;
-use crate::interaction::needle::Needle;
 use crate::kernels::math::Real;
 use crate::scene::body::Body;
 use crate::scene::cut::CutReport;
+use crate::scene::grasp_state::Grasp;
+use crate::scene::needle_state::Needle;
 use crate::scene::settings::Settings;
 use crate::scene::tool::{Tool, ToolLoad};
 

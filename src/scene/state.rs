@@ -14,12 +14,12 @@
 //! [`World::set_state`]: crate::World::set_state
 
 use crate::error::Error;
-use crate::interaction::grasp::Grasp;
-use crate::interaction::needle::ShaftHold;
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::kernels::parallel::Pool;
 use crate::scene::body::{Body, ParticleState};
 use crate::scene::cut::CutSets;
+use crate::scene::grasp_state::Grasp;
+use crate::scene::needle_state::ShaftHold;
 use crate::scene::tool::{Pose, Wrench};
 use crate::scene::Scene;
 use std::sync::Arc;

@@ -10,8 +10,6 @@ mod state;
 pub mod state_bytes;
 
 use crate::error::Error;
-use crate::interaction::grasp::{Grasp, GraspOptions};
-use crate::interaction::needle::{Needle, NeedleOptions, NeedleState};
 use crate::kernels::math::{is_finite_vec, Real, Vec3};
 use crate::mesh::TetMesh;
 use crate::model::body_model::{BodyModel, BodyOptions};
@@ -19,6 +17,8 @@ use crate::render::{RenderMesh, RenderSurface};
 use crate::scene::body::Body;
 use crate::scene::cut::{Blade, CutReport};
 use crate::scene::derived::DerivedFrom;
+use crate::scene::grasp_state::{Grasp, GraspOptions};
+use crate::scene::needle_state::{Needle, NeedleOptions, NeedleState};
 use crate::scene::settings::Settings;
 use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};

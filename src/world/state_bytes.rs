@@ -33,10 +33,10 @@
 //! [`World::set_state`]: crate::World::set_state
 
 use crate::error::Error;
-use crate::interaction::grasp::{Attachment, Grasp};
-use crate::interaction::needle::ShaftHold;
 use crate::kernels::math::{Quat, Real, Vec3};
 use crate::scene::body::ParticleState;
+use crate::scene::grasp_state::{Attachment, Grasp};
+use crate::scene::needle_state::ShaftHold;
 use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
 use crate::scene::tool::{Pose, Wrench};
 use std::sync::Arc;
