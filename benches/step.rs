@@ -6,6 +6,7 @@
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
 //!                             [--times PATH] [--dual-cells] [--tetrahedra] [--self-contact]
+//!                             [--profile]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -18,7 +19,9 @@
 //! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
 //! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron;
 //! `--tetrahedra` the elasticity on corotated tetrahedra (`ElasticScheme::Tetrahedra`).
-//! `--self-contact` switches the surface self-contact on (`Settings::self_contact`).
+//! `--self-contact` switches the surface self-contact on (`Settings::self_contact`);
+//! `--profile` prints each stage's mean wall time per timed step (`World::step_profile`; the
+//! clock reads add well under a microsecond a step).
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -30,8 +33,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, ElasticScheme, Material, Pose, Real, Settings, ToolOptions,
-    ToolShape, Vec3, VolumeScheme, World,
+    mesh, BodyId, BodyOptions, ElasticScheme, Material, Pose, Real, Settings, StepProfile,
+    ToolOptions, ToolShape, Vec3, VolumeScheme, World,
 };
 
 /// Counts live heap bytes, for memory per particle.
@@ -69,6 +72,26 @@ struct Row {
     contacts: u32,
     /// Every timed step's time (ms), in step order.
     series: Vec<f64>,
+    /// With `--profile`: each stage's mean wall time per timed step (µs), in
+    /// [`StepProfile`]'s order.
+    stages: Vec<(&'static str, f64)>,
+}
+
+/// The stages of `p` with their times (µs).
+fn stages(p: &StepProfile) -> [(&'static str, f64); 10] {
+    let us = |d: std::time::Duration| d.as_secs_f64() * 1e6;
+    [
+        ("state copy", us(p.state_copy)),
+        ("prediction", us(p.prediction)),
+        ("volume", us(p.volume)),
+        ("organ contact", us(p.organ_contact)),
+        ("self-contact", us(p.self_contact)),
+        ("tool contact", us(p.tool_contact)),
+        ("grasp, needle", us(p.grasp_and_needle)),
+        ("update", us(p.update)),
+        ("end of step", us(p.end_of_step)),
+        ("total", us(p.total)),
+    ]
 }
 
 fn percentile(sorted: &[f64], q: f64) -> f64 {
@@ -203,7 +226,13 @@ fn add_organs(world: &mut World, name: &str, scene: Scene) -> (Vec<BodyId>, Vec3
     (vec![a, b, c], lo, hi)
 }
 
-fn run(name: &str, scene: Scene, probe: bool, steps: usize, settings: &Settings) -> Row {
+fn run(
+    name: &str,
+    scene: Scene,
+    probe: bool,
+    (steps, profile): (usize, bool),
+    settings: &Settings,
+) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let mut world = World::new(settings.clone()).unwrap();
     let (bodies, lo, hi) = add_organs(&mut world, name, scene);
@@ -248,6 +277,8 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, settings: &Settings)
     }
     let mut times = Vec::with_capacity(steps);
     let mut contacts = 0;
+    world.set_profiling(profile);
+    let mut stage_sums: Vec<(&'static str, f64)> = Vec::new();
     for k in 0..steps {
         if let Some(t) = tool {
             // A small oscillation keeps the contact alive and changing.
@@ -257,6 +288,13 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, settings: &Settings)
         let t0 = Instant::now();
         world.step().unwrap();
         times.push(t0.elapsed().as_secs_f64() * 1e3);
+        if let Some(p) = world.step_profile() {
+            let now = stages(&p);
+            stage_sums.resize(now.len(), ("", 0.0));
+            for (sum, (name, us)) in stage_sums.iter_mut().zip(now) {
+                *sum = (name, sum.1 + us / steps as f64);
+            }
+        }
         if let Some(t) = tool {
             contacts = contacts.max(world.tool(t).unwrap().wrench().contact_count);
         }
@@ -283,6 +321,7 @@ fn run(name: &str, scene: Scene, probe: bool, steps: usize, settings: &Settings)
         bytes,
         contacts,
         series,
+        stages: stage_sums,
     }
 }
 
@@ -301,6 +340,7 @@ fn main() {
     let mut volume_scheme = VolumeScheme::Tetrahedra;
     let mut elastic_scheme = ElasticScheme::PointBased;
     let mut self_contact = false;
+    let mut profile = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -320,6 +360,7 @@ fn main() {
             "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
             "--tetrahedra" => elastic_scheme = ElasticScheme::Tetrahedra,
             "--self-contact" => self_contact = true,
+            "--profile" => profile = true,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -349,7 +390,7 @@ fn main() {
                 m,
                 scene(&scene_name),
                 probe,
-                steps,
+                (steps, profile),
                 &Settings {
                     threads,
                     volume_scheme,
@@ -364,6 +405,9 @@ fn main() {
                 "{:<10} {:>5} {:>9} {:>8} {:>4} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>10.1} {:>8.0} {:>5}",
                 r.mesh, r.probe, r.particles, r.pairs, r.substeps, r.median, r.p99, r.max, r.mean, per_k, bpp, r.contacts
             );
+            for (stage, us) in &r.stages {
+                println!("    {stage:<14} {us:>9.1} us/step (mean)");
+            }
             out += &format!(
                 "{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",
                 scene_name,

@@ -69,4 +69,5 @@ pub use scene::tool::{
     TOOL_SIZE_RANGE,
 };
 pub use scene::{BodyId, StepReport, ToolId, WorldState, TOOL_JUMP_FRACTION};
+pub use solver::profile::StepProfile;
 pub use world::{RenderSurfaceId, World};

@@ -1,5 +1,6 @@
 //! Same inputs, same bits: two runs of one scene (probe contact, friction, two bodies) agree
-//! exactly, and save → step N → restore → step N reproduces the positions bit for bit.
+//! exactly, and save → step N → restore → step N reproduces the positions bit for bit; neither
+//! the thread count nor profiling changes a bit.
 
 mod common;
 
@@ -186,4 +187,45 @@ fn a_corrupted_state_is_refused_and_changes_nothing() {
     wrong_version[8] = 99;
     assert!(world.restore_state(&wrong_version).is_err());
     assert_eq!(positions(&world), before);
+}
+
+/// Profiling reads clocks and nothing else: a profiled run gives the same bits. Its profile
+/// exists only while it is on, and the stages (contact with two bodies and a probe) lie within
+/// the step's total.
+#[test]
+fn profiling_changes_no_bit_and_accounts_for_the_step() {
+    let (mut plain, mut profiled) = (scene_with_threads(2), scene_with_threads(2));
+    assert!(profiled.step_profile().is_none());
+    profiled.set_profiling(true);
+    drive(&mut plain, 0, 300);
+    drive(&mut profiled, 0, 300);
+    assert_eq!(positions(&plain), positions(&profiled));
+    assert!(plain.step_profile().is_none());
+    let p = profiled
+        .step_profile()
+        .expect("a profile while profiling is on");
+    let stages = [
+        p.state_copy,
+        p.prediction,
+        p.volume,
+        p.organ_contact,
+        p.self_contact,
+        p.tool_contact,
+        p.grasp_and_needle,
+        p.update,
+        p.end_of_step,
+    ];
+    let sum: std::time::Duration = stages.iter().sum();
+    assert!(p.prediction > std::time::Duration::ZERO && p.tool_contact > std::time::Duration::ZERO);
+    assert!(
+        p.organ_contact > std::time::Duration::ZERO,
+        "two bodies touch"
+    );
+    assert!(
+        sum <= p.total,
+        "stages {sum:?} beyond the step's {:?}",
+        p.total
+    );
+    profiled.set_profiling(false);
+    assert!(profiled.step_profile().is_none());
 }

@@ -35,6 +35,7 @@
 mod divergence_check;
 mod organ_contact;
 mod predict;
+pub(crate) mod profile;
 pub mod statics;
 mod surface_self_contact;
 mod volume;
@@ -56,7 +57,9 @@ use crate::scene::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREA
 use crate::scene::tool::{Pose, ToolShape, Wrench};
 use crate::scene::{Scene, StepReport, ToolSlot};
 use crate::solver::divergence_check::ParticleScan;
+use crate::solver::profile::{Profiler, Stage};
 use parry3d_f64::math::Point;
+use std::time::Instant;
 
 /// The bodies' particle views over their step scratch, by body index.
 struct Views<'a> {
@@ -78,6 +81,8 @@ pub(crate) struct Pipeline {
     pub(crate) workspace: Workspace,
     /// The threads of the force, volume, prediction and update passes.
     pool: Pool,
+    /// The stages' wall times, when profiling is on.
+    pub(crate) profiler: Profiler,
 }
 
 impl Pipeline {
@@ -86,6 +91,7 @@ impl Pipeline {
         Pipeline {
             workspace: Workspace::default(),
             pool: Pool::new(threads as usize),
+            profiler: Profiler::default(),
         }
     }
 
@@ -118,9 +124,11 @@ impl Pipeline {
     /// [`Settings::divergence`](crate::Settings::divergence) the scene is rolled back to the
     /// start of the step and [`Error::Diverged`] says which body and why.
     pub(crate) fn step(&mut self, scene: &mut Scene) -> Result<StepReport, Error> {
+        let step_start = self.profiler.start();
         let (n, clamped) = scene.substeps_needed();
         let mut rollback = std::mem::take(&mut self.workspace.rollback);
         scene.state_into(&mut rollback, &self.pool);
+        let mut clock = self.profiler.charge(Stage::StateCopy, step_start);
         // A jump is not swept: the tool is placed at its target for the whole step and the
         // tissue it lands in leaves it at `max_depenetration_speed`. A blade does not push; it
         // cuts along its whole path, however fast.
@@ -138,7 +146,7 @@ impl Pipeline {
             slot.load.penetration = 0.0;
         }
         for k in 1..=n {
-            self.substep(scene, h, k, n);
+            clock = self.substep(scene, h, k, n, clock);
         }
         let limits = scene.settings.divergence;
         let failure = (scene.bodies.iter().zip(&rollback.bodies))
@@ -161,6 +169,8 @@ impl Pipeline {
             scene.apply_state(&rollback);
             self.fit_boundaries(&scene.bodies);
             self.workspace.rollback = rollback;
+            self.profiler.charge(Stage::EndOfStep, clock);
+            self.profiler.finish(step_start);
             return Err(Error::Diverged(format!(
                 "body {b} at t = {} s: {why}; the step was rolled back (move the tool away, \
                  restore a state, or reduce dt or the stiffness)",
@@ -216,6 +226,8 @@ impl Pipeline {
         }
         scene.time += dt;
         self.workspace.rollback = rollback;
+        self.profiler.charge(Stage::EndOfStep, clock);
+        self.profiler.finish(step_start);
         Ok(StepReport {
             substeps: n,
             substeps_clamped: clamped,
@@ -223,8 +235,16 @@ impl Pipeline {
         })
     }
 
-    /// Substep `k` of `n` (1-based) of length `h` (s).
-    fn substep(&mut self, scene: &mut Scene, h: Real, k: u32, n: u32) {
+    /// Substep `k` of `n` (1-based) of length `h` (s), its stages' times charged from `clock`
+    /// (profiling on); returns the end of its last stage.
+    fn substep(
+        &mut self,
+        scene: &mut Scene,
+        h: Real,
+        k: u32,
+        n: u32,
+        mut clock: Option<Instant>,
+    ) -> Option<Instant> {
         let s = &scene.settings;
         let gravity = s.gravity;
         let alpha_damp = 1.0 / (1.0 + s.damping_mass * h);
@@ -240,6 +260,7 @@ impl Pipeline {
                 &self.pool,
             );
         }
+        clock = self.profiler.charge(Stage::Prediction, clock);
         let organ_contact = scene.bodies.len() > 1;
         if organ_contact {
             let cell = 2.0
@@ -251,6 +272,7 @@ impl Pipeline {
             self.workspace
                 .grid
                 .build(scratch.iter().map(|s| s.p.as_slice()), cell);
+            clock = self.profiler.charge(Stage::OrganContact, clock);
         }
         for slot in scene.tools.iter_mut().flatten() {
             slot.load.contacts = 0;
@@ -271,6 +293,7 @@ impl Pipeline {
             }
         }
         let s_prev = (k - 1) as Real / n as Real;
+        clock = self.profiler.charge(Stage::GraspAndNeedle, clock);
         for it in 0..scene.settings.iterations {
             if scene.settings.volume_constraints {
                 for (body, scratch) in scene.bodies.iter().zip(scratch.iter_mut()) {
@@ -287,6 +310,7 @@ impl Pipeline {
                     }
                 }
             }
+            clock = self.profiler.charge(Stage::Volume, clock);
             if organ_contact {
                 organ_contact::project_organ_contacts(
                     &self.workspace.grid,
@@ -294,6 +318,7 @@ impl Pipeline {
                     scratch,
                     &scene.pair_friction,
                 );
+                clock = self.profiler.charge(Stage::OrganContact, clock);
             }
             if scene.settings.self_contact {
                 for (b, (body, scratch)) in scene.bodies.iter().zip(scratch.iter_mut()).enumerate()
@@ -309,6 +334,7 @@ impl Pipeline {
                         scene.settings.max_depenetration_speed * h,
                     );
                 }
+                clock = self.profiler.charge(Stage::SelfContact, clock);
             }
             let mode = scene.settings.contact_mode;
             let max_correction = scene.settings.max_depenetration_speed * h;
@@ -351,6 +377,7 @@ impl Pipeline {
                     }
                 }
             }
+            clock = self.profiler.charge(Stage::ToolContact, clock);
             for slot in scene.tools.iter_mut().flatten() {
                 if !slot.grasp.attachments.is_empty() {
                     let tool = &slot.tool;
@@ -374,6 +401,7 @@ impl Pipeline {
                 }
             }
         }
+        clock = self.profiler.charge(Stage::GraspAndNeedle, clock);
         // The update, and on the last substep the particle half of the divergence check,
         // one scan per share merged in share order.
         let inv_h = 1.0 / h;
@@ -421,5 +449,6 @@ impl Pipeline {
                 scratch.scan = shares.iter().fold(ParticleScan::EMPTY, |a, b| a.then(b));
             }
         }
+        self.profiler.charge(Stage::Update, clock)
     }
 }

@@ -22,6 +22,7 @@ use crate::scene::needle_state::{Needle, NeedleOptions, NeedleState};
 use crate::scene::settings::Settings;
 use crate::scene::tool::{check_friction, Pose, Tool, ToolOptions, ToolShape};
 use crate::scene::{BodyId, PairFriction, Scene, StepReport, ToolId, ToolSlot};
+use crate::solver::profile::StepProfile;
 use crate::solver::Pipeline;
 use std::sync::Arc;
 
@@ -407,6 +408,19 @@ impl World {
             self.diverged_steps += 1;
         }
         report
+    }
+
+    /// Measure the wall time of every stage of the steps from now on (`true`), or stop
+    /// (`false`, the default): [`World::step_profile`]. Off, a step reads no clock.
+    pub fn set_profiling(&mut self, on: bool) {
+        self.pipeline.profiler.set(on);
+    }
+
+    /// Where the last step's time went, stage by stage ([`StepProfile`]: wall times of the
+    /// calling thread, summed over the substeps), while profiling is on
+    /// ([`World::set_profiling`]); `None` when it is off or no step has run since.
+    pub fn step_profile(&self) -> Option<StepProfile> {
+        self.pipeline.profiler.last()
     }
 
     /// Bring the world to rest in its equilibrium under gravity, fixed particles held: a scene
