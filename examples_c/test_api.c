@@ -103,6 +103,47 @@ static void test_settle(double h) {
     ts_world_free(world);
 }
 
+/* ts_world_set_profiling / ts_world_step_profile: no profile while off; on, a step's stages are
+ * measured, lie within its total, and change no result (a twin world stepped without profiling
+ * ends at the same positions, bit for bit). */
+static void test_profile(double h) {
+    (void)h;
+    ts_settings settings;
+    ts_material material;
+    ts_world *plain = NULL, *profiled = NULL;
+    uint32_t a = 0, b = 0;
+    ts_step_profile p;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &plain));
+    CHECK_OK(ts_world_new(&settings, &profiled));
+    CHECK_OK(ts_world_add_body_from_arrays(plain, nodes, NN, tets, NT, &material, NULL, &a));
+    CHECK_OK(ts_world_add_body_from_arrays(profiled, nodes, NN, tets, NT, &material, NULL, &b));
+    CHECK_ST(ts_world_step_profile(profiled, NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_world_set_profiling(NULL, 1), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_world_step_profile(profiled, &p));
+    CHECK(p.measured == 0 && p.total == 0);
+    CHECK_OK(ts_world_set_profiling(profiled, 1));
+    for (int k = 0; k < 5; k++) {
+        CHECK_OK(ts_world_step(plain, NULL));
+        CHECK_OK(ts_world_step(profiled, NULL));
+    }
+    CHECK_OK(ts_world_step_profile(profiled, &p));
+    double stages = p.state_copy + p.prediction + p.volume + p.organ_contact + p.self_contact +
+                    p.tool_contact + p.grasp_and_needle + p.update + p.end_of_step;
+    CHECK(p.measured == 1 && p.prediction > 0 && p.volume > 0);
+    CHECK(stages <= p.total * (1 + 1e-9));
+    double xa[3 * NN], xb[3 * NN];
+    CHECK_OK(ts_body_positions(plain, a, xa, 3 * NN));
+    CHECK_OK(ts_body_positions(profiled, b, xb, 3 * NN));
+    CHECK(memcmp(xa, xb, sizeof xa) == 0);
+    CHECK_OK(ts_world_set_profiling(profiled, 0));
+    CHECK_OK(ts_world_step_profile(profiled, &p));
+    CHECK(p.measured == 0);
+    ts_world_free(plain);
+    ts_world_free(profiled);
+}
+
 /* The functions that cover the rest of the Rust API: body state, fixed flags, particle radius,
  * pair and tool friction, convex-hull and triangle-array tools, removing a tool, and a capsule
  * of half-height 0 (a sphere). Uses the lattice of build_lattice (edge CELLS * h). */
@@ -460,6 +501,7 @@ int main(void) {
     const double h = 0.02; /* 6 cm cube */
     build_lattice(h);
     test_settle(h);
+    test_profile(h);
     test_coverage(h);
     test_grasp(h);
     test_needle(h);

@@ -446,6 +446,59 @@ typedef struct ts_cut_report {
     uint64_t isolated;
 } ts_cut_report;
 
+/**
+ * The wall time (s) of each stage of the last step, summed over its substeps and iterations:
+ * the calling thread's time, waits for the world's other threads included.
+ */
+typedef struct ts_step_profile {
+    /**
+     * 1 when the stages below were measured (profiling on and a step run since), else 0 and
+     * every time 0.
+     */
+    uint32_t measured;
+    /**
+     * The copy of the state a diverged step is rolled back to (s).
+     */
+    double state_copy;
+    /**
+     * Gravity and elastic forces, velocities and predicted positions (s).
+     */
+    double prediction;
+    /**
+     * The volume constraints (s).
+     */
+    double volume;
+    /**
+     * Organ–organ contact (s).
+     */
+    double organ_contact;
+    /**
+     * Surface self-contact (s).
+     */
+    double self_contact;
+    /**
+     * Tool–tissue contact (s).
+     */
+    double tool_contact;
+    /**
+     * Grasps and needle holds (s).
+     */
+    double grasp_and_needle;
+    /**
+     * The update of positions and velocities (s).
+     */
+    double update;
+    /**
+     * The divergence check, grasp slip, cuts, the tools' wrenches and poses, needle puncture
+     * (s).
+     */
+    double end_of_step;
+    /**
+     * The whole step (s).
+     */
+    double total;
+} ts_step_profile;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1475,6 +1528,28 @@ enum ts_status ts_render_surface_write_obj(const struct ts_world *world,
 enum ts_status ts_render_surface_write_vtu(const struct ts_world *world,
                                            uint32_t surface,
                                            const char *path);
+
+/**
+ * Measure the wall time of every stage of the steps from now on (`on` non-zero), or stop
+ * (`on` 0, the default: a step then reads no clock). Profiling changes no result.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_set_profiling(struct ts_world *world, uint32_t on);
+
+/**
+ * Write where the last step's time went into *out_profile: its stages' wall times with
+ * `measured` 1 while profiling is on (ts_world_set_profiling) and a step has run since; all 0
+ * otherwise.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_profile` is NULL or writable.
+ */
+enum ts_status ts_world_step_profile(const struct ts_world *world,
+                                     struct ts_step_profile *out_profile);
 
 #ifdef __cplusplus
 }  // extern "C"
