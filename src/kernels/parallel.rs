@@ -15,6 +15,12 @@ use std::thread::{self, JoinHandle};
 /// A job: called once with each share index `0..threads`.
 type Job = dyn Fn(usize) + Sync;
 
+/// The `share`-th of `threads` contiguous, near-equal parts of `0..n` ([`Pool::share`] on a
+/// pool of `threads` threads).
+pub fn share_of(threads: usize, share: usize, n: usize) -> Range<usize> {
+    (share * n / threads)..((share + 1) * n / threads)
+}
+
 /// Spins (about a microsecond each) a waiting thread makes before it parks or yields.
 const SPINS: u32 = 20_000;
 
@@ -75,8 +81,7 @@ impl Pool {
 
     /// The `share`-th of `threads()` contiguous, near-equal parts of `0..n`.
     pub fn share(&self, share: usize, n: usize) -> Range<usize> {
-        let t = self.threads();
-        (share * n / t)..((share + 1) * n / t)
+        share_of(self.threads(), share, n)
     }
 
     /// Run `job(range)` for each share's contiguous range of `0..n` (see [`Pool::share`]), on

@@ -26,14 +26,14 @@
 //! hourglass control is needed (the hourglass setting does not apply).
 //!
 //! The pass takes the tetrahedra four at a time, one a lane. On one thread each chunk's corner
-//! forces go straight to the particles; on several it runs in two halves on the pool: each
-//! share of the chunks writes one slot per corner, and after a barrier each share of the
-//! particles sums its particles' slots in tetrahedron order. Every particle's force is so
-//! summed in tetrahedron order: the result is bit-identical for any number of threads.
+//! forces go straight to the particles; on several each share of the chunks adds them straight
+//! to the particles whose tetrahedra are all in its share and keeps those of the few particles
+//! whose tetrahedra span shares, which are summed after a barrier ([`TetShares`]). Every
+//! particle's force is so summed in tetrahedron order: the same bits on any number of threads.
 
 use crate::kernels::lanes::{F4, LANES, M4, V4};
 use crate::kernels::math::{Mat3, Quat, Real, Vec3};
-use crate::kernels::parallel::{Barrier, Pool, SharedSlice};
+use crate::kernels::parallel::{share_of, Barrier, Pool, SharedSlice};
 use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
 
@@ -181,21 +181,95 @@ pub(crate) struct TetForceInputs<'a> {
     pub(crate) fixed: &'a [bool],
 }
 
+/// Where the corner forces of the force pass go on several threads, for one body's tetrahedra and
+/// one thread count: the shares take the chunks of tetrahedra in [`Pool::share`]'s contiguous
+/// ranges. A particle all of whose tetrahedra fall in one share's range gets its corner forces
+/// added straight away by that share, in tetrahedron order; a particle whose tetrahedra span
+/// shares (those near a range's end) gets them kept, in tetrahedron order, and summed after the
+/// barrier. Either way a particle's force is summed in tetrahedron order, as on one thread.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct TetShares {
+    /// The thread count and the number of tetrahedra it was made for (0 threads: not made).
+    threads: usize,
+    count: usize,
+    /// Per corner slot `4 t + c` (corner `c` of tetrahedron `t`): [`TetShares::DIRECT`], or the
+    /// index of its kept force.
+    target: Vec<u32>,
+    /// The particles whose tetrahedra span shares, in increasing order, and the ranges
+    /// `kept_offsets[b]..kept_offsets[b + 1]` of their kept forces (in tetrahedron order).
+    spanning: Vec<u32>,
+    kept_offsets: Vec<u32>,
+    /// The kept corner forces (N).
+    kept: Vec<Vec3>,
+}
+
+impl TetShares {
+    /// A corner force added straight to its particle.
+    const DIRECT: u32 = u32::MAX;
+
+    /// Make the layout for `elements` on `threads` threads (nothing on one thread). Reuses its
+    /// memory: allocates only when `elements` has more corners or spanning particles than any
+    /// layout before.
+    pub(crate) fn fit(&mut self, elements: &TetElements, threads: usize) {
+        self.threads = if threads > 1 { threads } else { 0 };
+        self.count = elements.count;
+        self.target.clear();
+        self.spanning.clear();
+        self.kept_offsets.clear();
+        if threads == 1 {
+            return;
+        }
+        let chunks = elements.chunks.len();
+        let share_of = |slot: u32| {
+            let chunk = slot as usize / 4 / LANES;
+            (0..threads)
+                .find(|&s| share_of(threads, s, chunks).contains(&chunk))
+                .unwrap_or(0)
+        };
+        self.target.resize(4 * elements.count, TetShares::DIRECT);
+        self.kept_offsets.push(0);
+        let mut kept = 0u32;
+        for (i, range) in elements.corner_offsets.windows(2).enumerate() {
+            let slots = &elements.corners[range[0] as usize..range[1] as usize];
+            let Some(&first) = slots.first() else {
+                continue;
+            };
+            let share = share_of(first);
+            if slots.iter().all(|&slot| share_of(slot) == share) {
+                continue;
+            }
+            self.spanning.push(i as u32);
+            for &slot in slots {
+                self.target[slot as usize] = kept;
+                kept += 1;
+            }
+            self.kept_offsets.push(kept);
+        }
+        self.kept.resize(kept as usize, Vec3::zeros());
+    }
+
+    /// [`TetShares::fit`] for `elements` (after a cut) on the thread count it was made for.
+    pub(crate) fn refit(&mut self, elements: &TetElements) {
+        self.fit(elements, self.threads.max(1));
+    }
+}
+
 /// Add every tetrahedron's elastic (and damping) forces (N) to `force`, one per particle.
-/// `corner_force` is scratch with four entries per tetrahedron, used on several threads only
-/// (it may be empty on one): nothing is allocated. Unless `compressed` is empty (one entry per
+/// `shares` says where each corner force goes on several threads ([`TetShares::fit`] for these
+/// elements and this pool; unused on one thread): nothing is allocated. Unless `compressed` is empty (one entry per
 /// chunk of four tetrahedra, [`TetElements::chunk_count`]), bit `l` of chunk `c`'s entry is set
 /// where tetrahedron `4 c + l` is below [`COMPRESSED_RATIO`] of its rest volume at `x`, from
 /// the pass's own `det F` (a chunk whose corners are all fixed reads 0).
 ///
 /// On one thread each chunk's corner forces go straight to the particles, chunk after chunk;
-/// on several, each share of the chunks writes its corner slots, and after a barrier each
-/// share of the particles sums its particles' slots in tetrahedron order. A particle's force
-/// is so summed in tetrahedron order either way: the same bits on any number of threads.
+/// on several, each share of the chunks adds its particles' forces straight away where the
+/// particle's tetrahedra are all its own, and keeps the others' (see [`TetShares`]), summed
+/// after a barrier in tetrahedron order. A particle's force is so summed in tetrahedron order
+/// either way: the same bits on any number of threads.
 pub(crate) fn accumulate_forces(
     model: &ElasticModel,
     input: &TetForceInputs<'_>,
-    corner_force: &mut [Vec3],
+    shares: &mut TetShares,
     compressed: &mut [u8],
     force: &mut [Vec3],
     pool: &Pool,
@@ -243,25 +317,26 @@ pub(crate) fn accumulate_forces(
         return;
     }
     assert!(
-        corner_force.len() >= 4 * m,
-        "the corner slots are sized for several threads"
+        shares.threads == pool.threads() && shares.count == m,
+        "the shares are made for this thread count and these tetrahedra (TetShares::fit)"
     );
-    let slots = SharedSlice::new(&mut corner_force[..4 * m]);
+    let TetShares {
+        target,
+        spanning,
+        kept_offsets,
+        kept,
+        ..
+    } = shares;
+    let kept = SharedSlice::new(kept);
     let compressed = SharedSlice::new(compressed);
     let forces = SharedSlice::new(force);
     let barrier = Barrier::new(pool.threads());
     pool.run(&|share| {
         let _guard = barrier.guard();
         let mine = pool.share(share, chunks.len());
-        let (first, last) = (LANES * mine.start, (LANES * mine.end).min(m));
-        // SAFETY: the shares' chunks, hence their tetrahedra's corner slots and their
-        // entries of `compressed`, are disjoint.
-        let out = unsafe { slots.range(4 * first..4 * last) };
+        // SAFETY: the shares' chunks, hence their entries of `compressed`, are disjoint.
         let flags = unsafe { compressed.range(if report { mine.clone() } else { 0..0 }) };
-        for (c, (chunk, out)) in mine
-            .clone()
-            .zip(chunks[mine.clone()].iter().zip(out.chunks_mut(4 * LANES)))
-        {
+        for (c, chunk) in mine.clone().zip(&chunks[mine.clone()]) {
             if inert(chunk) {
                 if report {
                     flags[c - mine.start] = 0;
@@ -272,22 +347,27 @@ pub(crate) fn accumulate_forces(
             if report {
                 flags[c - mine.start] = compressed_bits(c, ratio);
             }
-            for (l, out) in out.chunks_mut(4).enumerate() {
-                for (slot, corner) in out.iter_mut().zip(&corners) {
-                    *slot = corner[l];
+            for (l, tet) in chunk.tets.iter().enumerate().take(m - LANES * c) {
+                let t = LANES * c + l;
+                for (k, (corner, &i)) in corners.iter().zip(tet).enumerate() {
+                    // SAFETY: a particle with a direct corner has all its tetrahedra in this
+                    // share, so no other share writes its force; a kept slot is its corner's
+                    // own, written by the share of its tetrahedron only.
+                    match target[4 * t + k] {
+                        TetShares::DIRECT => *unsafe { forces.element(i as usize) } += corner[l],
+                        slot => *unsafe { kept.element(slot as usize) } = corner[l],
+                    }
                 }
             }
         }
         barrier.wait();
-        let particles = pool.share(share, n);
-        // SAFETY: every share has written its slots (the barrier); from here they are only
-        // read, and each share writes only its own particles' forces.
-        let (all, f) = unsafe { (slots.read(0..4 * m), forces.range(particles.clone())) };
-        for (f, i) in f.iter_mut().zip(particles) {
-            let range =
-                elements.corner_offsets[i] as usize..elements.corner_offsets[i + 1] as usize;
-            for &slot in &elements.corners[range] {
-                *f += all[slot as usize];
+        // SAFETY: every share has written its kept slots (the barrier); from here they are
+        // only read, and each share adds to its own spanning particles only.
+        let all = unsafe { kept.read(0..kept.len()) };
+        for b in pool.share(share, spanning.len()) {
+            let f = unsafe { forces.element(spanning[b] as usize) };
+            for k in &all[kept_offsets[b] as usize..kept_offsets[b + 1] as usize] {
+                *f += *k;
             }
         }
     });
@@ -465,14 +545,20 @@ mod tests {
             v,
             fixed: &[],
         };
-        let mut slots = vec![Vec3::zeros(); 4 * tets.len()];
+        let mut shares = TetShares::default();
+        shares.fit(&elements, threads);
+        if threads > 1 {
+            // Both ways of summing are exercised: particles of one share, and spanning ones.
+            let direct = shares.target.contains(&TetShares::DIRECT);
+            assert!(direct && !shares.spanning.is_empty());
+        }
         let mut force = vec![Vec3::zeros(); x.len()];
         let mut compressed = vec![0xff; elements.chunk_count()];
         let pool = Pool::new(threads);
         accumulate_forces(
             model,
             &input,
-            &mut slots,
+            &mut shares,
             &mut compressed,
             &mut force,
             &pool,

@@ -334,11 +334,11 @@ impl Derived {
                 v: &at_rest,
                 fixed: &[],
             };
-            // One thread keeps no corner forces.
+            // One thread needs no shares.
             tet_elasticity::accumulate_forces(
                 &self.elastic,
                 &input,
-                &mut [],
+                &mut tet_elasticity::TetShares::default(),
                 &mut [],
                 &mut force,
                 &Pool::new(1),

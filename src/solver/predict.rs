@@ -69,7 +69,7 @@ pub(crate) fn predict(
                 v: &body.state.v,
                 fixed: &body.fixed,
             },
-            &mut scratch.corner_force,
+            &mut scratch.tet_shares,
             &mut scratch.compressed,
             &mut scratch.force,
             pool,

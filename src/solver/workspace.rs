@@ -4,6 +4,7 @@
 
 use crate::kernels::collision::hash_grid::HashGrid;
 use crate::kernels::math::{Real, Vec3};
+use crate::kernels::tet_elasticity::TetShares;
 use crate::model::body_model::BodyModel;
 use crate::model::dual_cells::CellSlot;
 use crate::scene::body::Body;
@@ -31,10 +32,10 @@ pub(crate) struct StepScratch {
     /// one per dual cell, in the cells' projection order (`DualCells::colours`; the
     /// array holds the larger count).
     pub(crate) tet_lambda: Vec<Real>,
-    /// The corner forces of the tetrahedron force pass (N) kept for the sums after its
-    /// barrier, four per load-time tetrahedron (`ElasticScheme::Tetrahedra`; a cut body uses
-    /// the first ones); empty on one thread, where they go straight to the particles.
-    pub(crate) corner_force: Vec<Vec3>,
+    /// Where the tetrahedron force pass puts its corner forces on several threads, and those it
+    /// keeps for the sums after its barrier (`ElasticScheme::Tetrahedra`; made for the body's
+    /// current tetrahedra and the thread count).
+    pub(crate) tet_shares: TetShares,
     /// The tetrahedra the force pass found below half their rest volume at the substep's start
     /// (`kernels::tet_elasticity::COMPRESSED_RATIO`), one bit a tetrahedron, one entry per
     /// chunk of four (`ElasticScheme::Tetrahedra`; sized for the load-time tetrahedra, a cut
@@ -58,7 +59,7 @@ impl StepScratch {
             pair_force: Vec::new(),
             own_force: Vec::new(),
             tet_lambda: vec![0.0; model.tets.len().max(n)],
-            corner_force: Vec::new(),
+            tet_shares: TetShares::default(),
             compressed: vec![0; model.tet_elements.chunk_count()],
             cell_scratch: Vec::new(),
             scan: ParticleScan::EMPTY,
@@ -84,18 +85,14 @@ impl StepScratch {
     /// none on one: the memory is freed) and the dual-cell scratch (a run per thread; a cut
     /// only removes tetrahedra, so no star outgrows it).
     fn size_kept(&mut self, model: &BodyModel, threads: usize) {
-        let (slots, particles, corners) = match threads {
-            1 => (0, 0, 0),
-            _ => (
-                model.nbr.slot_count(),
-                model.particle_count(),
-                4 * model.tets.len(),
-            ),
+        let (slots, particles) = match threads {
+            1 => (0, 0),
+            _ => (model.nbr.slot_count(), model.particle_count()),
         };
+        self.tet_shares.fit(&model.tet_elements, threads);
         for (kept, len) in [
             (&mut self.pair_force, slots),
             (&mut self.own_force, particles),
-            (&mut self.corner_force, corners),
         ] {
             kept.resize(len, Vec3::zeros());
             kept.shrink_to_fit();
@@ -130,12 +127,14 @@ impl Workspace {
         self.self_contact.reserve(model);
     }
 
-    /// Size the surface self-contact scratch for bodies on `models` after a change of
-    /// topology (a cut or a restored cut state changes a boundary): the step after it then
-    /// allocates nothing.
+    /// Size the surface self-contact scratch and refit the tetrahedron force pass's shares for
+    /// the bodies on `models` (in body order) after a change of topology (a cut or a restored
+    /// cut state changes a boundary and the tetrahedra): the step after it then allocates
+    /// nothing.
     pub(crate) fn fit_boundaries<'a>(&mut self, models: impl Iterator<Item = &'a BodyModel>) {
-        for model in models {
+        for (scratch, model) in self.bodies.iter_mut().zip(models) {
             self.self_contact.reserve(model);
+            scratch.tet_shares.refit(&model.tet_elements);
         }
     }
 
