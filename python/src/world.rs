@@ -18,7 +18,7 @@ use crate::state::WorldState;
 use crate::tool::{Pose, Tool, ToolOptions, ToolShape};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 use std::sync::Arc;
 use tissuesim::Real;
 
@@ -181,6 +181,36 @@ impl World {
     /// Number of steps that diverged and were rolled back.
     fn diverged_steps(&self) -> u64 {
         self.inner.diverged_steps()
+    }
+    /// Measure the wall time of every stage of the steps from now on (`True`), or stop
+    /// (`False`, the default: a step then reads no clock). Profiling changes no result.
+    fn set_profiling(&mut self, on: bool) {
+        self.inner.set_profiling(on);
+    }
+    /// Where the last step's time went: a dict of each stage's wall time (s) by name (`state_copy`,
+    /// `prediction`, `volume`, `organ_contact`, `self_contact`, `tool_contact`,
+    /// `grasp_and_needle`, `update`, `end_of_step`, `total`); `None` while profiling is off or
+    /// before a step has run since it was switched on.
+    fn step_profile<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(p) = self.inner.step_profile() else {
+            return Ok(None);
+        };
+        let stages = PyDict::new(py);
+        for (name, time) in [
+            ("state_copy", p.state_copy),
+            ("prediction", p.prediction),
+            ("volume", p.volume),
+            ("organ_contact", p.organ_contact),
+            ("self_contact", p.self_contact),
+            ("tool_contact", p.tool_contact),
+            ("grasp_and_needle", p.grasp_and_needle),
+            ("update", p.update),
+            ("end_of_step", p.end_of_step),
+            ("total", p.total),
+        ] {
+            stages.set_item(name, time.as_secs_f64())?;
+        }
+        Ok(Some(stages))
     }
     /// Add a deformable body built from `mesh` (m) with `options` (default `BodyOptions()`).
     #[pyo3(signature = (mesh, options = None))]

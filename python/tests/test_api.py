@@ -296,6 +296,23 @@ def test_a_diverged_step_raises_and_is_rolled_back():
     assert world.diverged_steps() == 1
 
 
+def test_profiling_times_the_stages_and_changes_no_result():
+    plain, profiled = ts.World(), ts.World()
+    a, b = small_block(plain), small_block(profiled)
+    assert profiled.step_profile() is None
+    profiled.set_profiling(True)
+    for _ in range(5):
+        plain.step()
+        profiled.step()
+    stages = profiled.step_profile()
+    assert stages is not None and stages["prediction"] > 0.0 and stages["volume"] > 0.0
+    total = stages.pop("total")
+    assert sum(stages.values()) <= total * (1 + 1e-9)
+    assert np.array_equal(plain.body(a).positions(), profiled.body(b).positions())
+    profiled.set_profiling(False)
+    assert profiled.step_profile() is None
+
+
 def test_linear_statics_in_node_order_match_a_slow_settle():
     # The particles carry λ (no volume constraints): the discretisation the linear solve has.
     world = ts.World(ts.Settings(volume_constraints=False))

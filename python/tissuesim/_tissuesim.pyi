@@ -714,6 +714,10 @@ class World:
     def time(self) -> float:
         """Simulated time (s)."""
     def diverged_steps(self) -> int: ...
+    def set_profiling(self, on: bool) -> None:
+        """Measure each stage's wall time from the next step on (``False``: stop; the default)."""
+    def step_profile(self) -> dict[str, float] | None:
+        """The last step's stage wall times (s) by name, ``None`` while profiling is off."""
     def add_body(self, mesh: TetMesh, options: BodyOptions | None = None) -> BodyId:
         """Add a deformable body from ``mesh`` (m)."""
     def add_body_model(self, model: BodyModel) -> BodyId: ...
