@@ -308,16 +308,29 @@ pub(crate) fn project_tool_surface(
 
 /// How far each corner of a triangle moves, in units of a correction of its contact point at
 /// barycentric `weights`, for corner inverse masses `w`: the mass-weighted least-norm shares
-/// `s_k ∝ b_k w_k` with `Σ b_k s_k = 1` (the contact point moves by exactly the correction),
-/// each at most [`MAX_CORNER_SHARE`]. A corner that would move more is held at the cap and the
-/// rest of the correction goes to the others in the same proportion, so that a light corner
-/// beside heavier ones does not leave the contact point short; only when every corner that can
-/// move is at the cap (a contact point next to fixed corners) is `Σ b_k s_k < 1`.
+/// `s_k = λ b_k w_k` with `Σ b_k s_k = 1` (the contact point moves by exactly the correction,
+/// `λ = 1 / Σ b_j² w_j`), each at most [`MAX_CORNER_SHARE`]. A corner that would move more is
+/// held at the cap and the rest of the correction goes to the others in the same proportion
+/// (a larger common `λ`), so that a light corner beside heavier ones does not leave the contact
+/// point short; but `λ` grows to at most [`MAX_CORNER_SHARE`] times its uncapped value. Without
+/// that bound the excess of a corner next to the contact point went whole to a corner at a
+/// tiny barycentric weight (the contact point on the edge between a free and a fixed corner):
+/// its share `≈ target / b_k` hit the cap, and the far corner moved twice the correction, pass
+/// after pass, while the contact point barely moved (the soak run's diverged steps: a corner
+/// 28 mm from the contact point of a capsule flung out of the organ). When the remaining
+/// corners cannot take the excess within these bounds, `Σ b_k s_k < 1`, and what is left stays
+/// as residual penetration.
 fn corner_shares(weights: &[Real; 3], w: &[Real; 3]) -> [Real; 3] {
     let mut shares = [0.0; 3];
     let mut capped = [false; 3];
     // What the corners not at the cap must still achieve of the correction.
     let mut target = 1.0;
+    let uncapped_denominator: Real = (0..3).map(|k| weights[k] * weights[k] * w[k]).sum();
+    if uncapped_denominator <= 0.0 {
+        return shares;
+    }
+    // The largest common multiplier λ the redistribution may reach.
+    let max_lambda = MAX_CORNER_SHARE / uncapped_denominator;
     // Each round caps at least one more corner, or ends.
     for _ in 0..3 {
         let denominator: Real = (0..3)
@@ -327,12 +340,13 @@ fn corner_shares(weights: &[Real; 3], w: &[Real; 3]) -> [Real; 3] {
         if denominator <= 0.0 {
             break;
         }
+        let lambda = (target / denominator).min(max_lambda);
         let mut newly_capped = false;
         for k in 0..3 {
             if capped[k] {
                 continue;
             }
-            shares[k] = weights[k] * w[k] / denominator * target;
+            shares[k] = weights[k] * w[k] * lambda;
             if shares[k] > MAX_CORNER_SHARE {
                 shares[k] = MAX_CORNER_SHARE;
                 capped[k] = true;
@@ -785,6 +799,38 @@ mod tests {
             near > 100 && overlapping > 100 && apart > 100,
             "{near} {overlapping} {apart}"
         );
+    }
+
+    /// The shares of a triangle with a free corner `A` next to the contact point, a fixed corner
+    /// and a free corner `B` at a tiny barycentric weight (the contact point on the edge from `A`
+    /// to the fixed corner, the case of the soak run): `A` at the cap, and `B`, which can hardly
+    /// move the contact point, moves by a tiny fraction of the correction, not by twice it.
+    #[test]
+    fn a_far_corner_does_not_take_a_capped_corners_excess() {
+        // Barycentric weights and inverse masses (1/kg) printed by the soak run's replay.
+        let (weights, w) = ([0.28, 1.0e-4, 0.72 - 1.0e-4], [2589.2, 2991.5, 0.0]);
+        let shares = corner_shares(&weights, &w);
+        assert_eq!(shares[0], MAX_CORNER_SHARE);
+        assert_eq!(shares[2], 0.0);
+        // Its uncapped least-norm share, grown at most MAX_CORNER_SHARE-fold.
+        let uncapped =
+            weights[1] * w[1] / (0..3).map(|k| weights[k] * weights[k] * w[k]).sum::<Real>();
+        assert!(
+            shares[1] <= MAX_CORNER_SHARE * uncapped * (1.0 + 1e-12),
+            "{shares:?}"
+        );
+        assert!(shares[1] < 0.01, "{shares:?}");
+    }
+
+    /// A light corner beside two heavier ones at comparable weights: the light one at the cap,
+    /// the others take its excess, and the contact point moves by the whole correction.
+    #[test]
+    fn heavier_corners_take_a_light_corners_excess() {
+        let (weights, w) = ([0.3, 0.35, 0.35], [10.0, 1.0, 1.0]);
+        let shares = corner_shares(&weights, &w);
+        assert_eq!(shares[0], MAX_CORNER_SHARE);
+        let achieved: Real = (0..3).map(|k| weights[k] * shares[k]).sum();
+        assert!((achieved - 1.0).abs() < 1e-12, "{shares:?}");
     }
 
     #[test]
