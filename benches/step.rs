@@ -73,25 +73,8 @@ struct Row {
     /// Every timed step's time (ms), in step order.
     series: Vec<f64>,
     /// With `--profile`: each stage's mean wall time per timed step (µs), in
-    /// [`StepProfile`]'s order.
+    /// `StepProfile::stages` order.
     stages: Vec<(&'static str, f64)>,
-}
-
-/// The stages of `p` with their times (µs).
-fn stages(p: &StepProfile) -> [(&'static str, f64); 10] {
-    let us = |d: std::time::Duration| d.as_secs_f64() * 1e6;
-    [
-        ("state copy", us(p.state_copy)),
-        ("prediction", us(p.prediction)),
-        ("volume", us(p.volume)),
-        ("organ contact", us(p.organ_contact)),
-        ("self-contact", us(p.self_contact)),
-        ("tool contact", us(p.tool_contact)),
-        ("grasp, needle", us(p.grasp_and_needle)),
-        ("update", us(p.update)),
-        ("end of step", us(p.end_of_step)),
-        ("total", us(p.total)),
-    ]
 }
 
 fn percentile(sorted: &[f64], q: f64) -> f64 {
@@ -289,10 +272,10 @@ fn run(
         world.step().unwrap();
         times.push(t0.elapsed().as_secs_f64() * 1e3);
         if let Some(p) = world.step_profile() {
-            let now = stages(&p);
+            let now = p.stages();
             stage_sums.resize(now.len(), ("", 0.0));
-            for (sum, (name, us)) in stage_sums.iter_mut().zip(now) {
-                *sum = (name, sum.1 + us / steps as f64);
+            for (sum, (name, time)) in stage_sums.iter_mut().zip(now) {
+                *sum = (name, sum.1 + time.as_secs_f64() * 1e6 / steps as f64);
             }
         }
         if let Some(t) = tool {
@@ -406,7 +389,7 @@ fn main() {
                 r.mesh, r.probe, r.particles, r.pairs, r.substeps, r.median, r.p99, r.max, r.mean, per_k, bpp, r.contacts
             );
             for (stage, us) in &r.stages {
-                println!("    {stage:<14} {us:>9.1} us/step (mean)");
+                println!("    {stage:<16} {us:>9.1} us/step (mean)");
             }
             out += &format!(
                 "{},{},{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{:.2},{:.0},{}\n",

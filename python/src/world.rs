@@ -196,18 +196,7 @@ impl World {
             return Ok(None);
         };
         let stages = PyDict::new(py);
-        for (name, time) in [
-            ("state_copy", p.state_copy),
-            ("prediction", p.prediction),
-            ("volume", p.volume),
-            ("organ_contact", p.organ_contact),
-            ("self_contact", p.self_contact),
-            ("tool_contact", p.tool_contact),
-            ("grasp_and_needle", p.grasp_and_needle),
-            ("update", p.update),
-            ("end_of_step", p.end_of_step),
-            ("total", p.total),
-        ] {
+        for (name, time) in p.stages() {
             stages.set_item(name, time.as_secs_f64())?;
         }
         Ok(Some(stages))

@@ -34,6 +34,24 @@ pub struct StepProfile {
     pub total: Duration,
 }
 
+impl StepProfile {
+    /// The stages by their field names, in the order of a step, then `("total", total)`.
+    pub fn stages(&self) -> [(&'static str, Duration); 10] {
+        [
+            ("state_copy", self.state_copy),
+            ("prediction", self.prediction),
+            ("volume", self.volume),
+            ("organ_contact", self.organ_contact),
+            ("self_contact", self.self_contact),
+            ("tool_contact", self.tool_contact),
+            ("grasp_and_needle", self.grasp_and_needle),
+            ("update", self.update),
+            ("end_of_step", self.end_of_step),
+            ("total", self.total),
+        ]
+    }
+}
+
 /// A stage of [`StepProfile`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Stage {
