@@ -33,8 +33,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, ElasticScheme, Material, Pose, Real, Settings, StepProfile,
-    ToolOptions, ToolShape, Vec3, VolumeScheme, World,
+    mesh, BodyId, BodyOptions, ElasticScheme, Material, Pose, Real, Settings, ToolOptions,
+    ToolShape, Vec3, VolumeScheme, World,
 };
 
 /// Counts live heap bytes, for memory per particle.
