@@ -81,9 +81,10 @@ impl StepScratch {
         }
     }
 
-    /// Size the force pass's kept forces for `threads` threads (a body's worth on several,
-    /// none on one: the memory is freed) and the dual-cell scratch (a run per thread; a cut
-    /// only removes tetrahedra, so no star outgrows it).
+    /// Size the particles' force pass's kept forces for `threads` threads (a body's worth on
+    /// several, none on one: the memory is freed), make the tetrahedra's shares for them, and
+    /// size the dual-cell scratch (a run per thread; a cut only removes tetrahedra, so no star
+    /// outgrows it).
     fn size_kept(&mut self, model: &BodyModel, threads: usize) {
         let (slots, particles) = match threads {
             1 => (0, 0),
