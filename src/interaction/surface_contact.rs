@@ -56,8 +56,8 @@ pub(crate) const MAX_SURFACE_PASSES: usize = 8;
 /// at 2 m/s across the fixed top flung a free corner of a triangle with fixed ones and the step
 /// diverged; with the per-corner bound in the first round too, the rod got into the organ.
 /// Measured (`tests/contact_deep_press.rs`): every sphere of 1–10 mm, the rod and the cube,
-/// pressed 3 cm from four sides, keep the surface at the contact skin (at most 0.02 mm inside,
-/// the 10 mm sphere along +z). Cost: about 1–3% of the haptic step.
+/// pressed 3 cm from four sides, keep the surface at the contact skin (never inside the probe:
+/// at least 0.18 mm outside, the 5 mm sphere along −z). Cost: about 1–3% of the haptic step.
 pub(crate) const SURFACE_ROUNDS: usize = 2;
 
 /// Most a corner moves per contact correction, in units of that correction. The point–triangle
