@@ -1,10 +1,10 @@
 //! Where a step's time goes, from C: the wall time of each stage of the last step (see the Rust
 //! `World::set_profiling` and `World::step_profile`).
 
-use crate::ffi::args::{non_null, world_mut, world_ref, write};
+use crate::ffi::args::world_mut;
 use crate::ffi::guard::guard;
 use crate::ffi::status::ts_status;
-use crate::ffi::world::ts_world;
+use crate::ffi::world::{ts_world, world_value};
 use crate::solver::profile::StepProfile;
 
 /// The wall time (s) of each stage of the last step, summed over its substeps and iterations:
@@ -89,13 +89,10 @@ pub unsafe extern "C" fn ts_world_step_profile(
     world: *const ts_world,
     out_profile: *mut ts_step_profile,
 ) -> ts_status {
-    guard(|| {
-        non_null(out_profile, "out_profile")?;
-        // SAFETY: contract of this function.
-        let h = unsafe { world_ref(world)? };
-        let profile = ts_step_profile::from(h.world.step_profile());
-        // SAFETY: checked non-NULL.
-        unsafe { write(out_profile, profile) };
-        Ok(())
-    })
+    // SAFETY: contract of this function.
+    unsafe {
+        world_value(world, out_profile, "out_profile", |w| {
+            ts_step_profile::from(w.step_profile())
+        })
+    }
 }

@@ -456,7 +456,7 @@ pub unsafe extern "C" fn ts_world_diverged_steps(
 /// # Safety
 ///
 /// `world` is NULL or a live handle; `out` is NULL or writable.
-unsafe fn world_value<T>(
+pub(crate) unsafe fn world_value<T>(
     world: *const ts_world,
     out: *mut T,
     out_name: &str,
