@@ -5,10 +5,7 @@
 
 mod common;
 
-use tissuesim::{
-    Blade, BodyId, ElasticScheme, Error, Pose, Real, Settings, ToolOptions, ToolShape, Vec3,
-    VolumeScheme, World,
-};
+use tissuesim::{Blade, BodyId, Error, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World};
 
 /// A 12 × 3 × 3 cm bar of firm tissue (E = 100 kPa, ν = 0.45, ρ = 1060 kg/m³: it sags a few
 /// millimetres) along x, cells of 1.5 cm, its end x = −6 cm fixed.
@@ -185,16 +182,14 @@ fn cuts_are_deterministic_and_survive_save_and_restore() {
     assert!(matches!(other.restore_state(&bad), Err(Error::BadState(_))));
 }
 
-/// With the elasticity on tetrahedra the force pass shares the tetrahedra among the threads by
-/// a layout made for the current tetrahedra: after a cut, and after restoring a cut state into a
-/// world never cut, one and two threads still give the same bits.
+/// The default's force pass shares the tetrahedra among the threads by a layout made for the
+/// current tetrahedra: after a cut, and after restoring a cut state into a world never cut,
+/// one and two threads still give the same bits.
 #[test]
 fn cuts_on_tetrahedra_give_the_same_bits_on_one_and_two_threads() {
     let tetrahedra = |threads| {
         bar_with(Settings {
             threads,
-            elastic_scheme: ElasticScheme::Tetrahedra,
-            volume_scheme: VolumeScheme::DualCells,
             ..Settings::default()
         })
     };

@@ -108,6 +108,16 @@ pub fn weightless() -> Settings {
     }
 }
 
+/// The paper's method: point-based (MLS) particles with per-tetrahedron volume constraints,
+/// selectable beside the default (tetrahedra with dual-cell volume constraints).
+pub fn paper(settings: Settings) -> Settings {
+    Settings {
+        elastic_scheme: tissuesim::ElasticScheme::PointBased,
+        volume_scheme: tissuesim::VolumeScheme::Tetrahedra,
+        ..settings
+    }
+}
+
 /// Axis-aligned bounding box (min, max) of points.
 pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     let mut lo = points[0];
