@@ -5,8 +5,8 @@
 //! cargo bench --bench step -- [--meshes liver_1k6,liver_4k,liver_10k,liver_31k,three_organs]
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
-//!                             [--times PATH] [--dual-cells] [--tetrahedra] [--self-contact]
-//!                             [--profile]
+//!                             [--times PATH] [--particles] [--tet-volumes] [--paper]
+//!                             [--self-contact] [--profile]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -16,9 +16,11 @@
 //!   ρ = 1, dt = 1 ms, top 3% fixed, gravity 9.81.
 //!
 //! With `probe`, a sphere (radius 5% of the organ's size) is pressed into the side of the organ
-//! by 15% of its size. `--threads` sets `Settings::threads` (default 1); `--dual-cells` one volume
-//! constraint per particle (`VolumeScheme::DualCells`) instead of one per tetrahedron;
-//! `--tetrahedra` the elasticity on corotated tetrahedra (`ElasticScheme::Tetrahedra`).
+//! by 15% of its size. `--threads` sets `Settings::threads` (default 1). The default settings put
+//! the elasticity on corotated tetrahedra and one volume constraint on each particle's dual cell;
+//! `--particles` puts the elasticity on the paper's point-based particles
+//! (`ElasticScheme::PointBased`), `--tet-volumes` one volume constraint on each tetrahedron
+//! (`VolumeScheme::Tetrahedra`), and `--paper` both: the paper's method.
 //! `--self-contact` switches the surface self-contact on (`Settings::self_contact`);
 //! `--profile` prints each stage's mean wall time per timed step (`World::step_profile`; the
 //! clock reads add well under a microsecond a step).
@@ -340,8 +342,12 @@ fn main() {
             "--times" => times_csv = Some(PathBuf::from(args.next().expect("--times PATH"))),
             "--scene" => scene_name = args.next().expect("--scene haptic|pypbd"),
             "--threads" => threads = args.next().expect("--threads N").parse().expect("a number"),
-            "--dual-cells" => volume_scheme = VolumeScheme::DualCells,
-            "--tetrahedra" => elastic_scheme = ElasticScheme::Tetrahedra,
+            "--particles" => elastic_scheme = ElasticScheme::PointBased,
+            "--tet-volumes" => volume_scheme = VolumeScheme::Tetrahedra,
+            "--paper" => {
+                elastic_scheme = ElasticScheme::PointBased;
+                volume_scheme = VolumeScheme::Tetrahedra;
+            }
             "--self-contact" => self_contact = true,
             "--profile" => profile = true,
             "--bench" => {}

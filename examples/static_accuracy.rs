@@ -1,16 +1,19 @@
 //! Static small-strain accuracy against the committed FEM references (validation/reference):
-//! the linear gravity sag `K u = m g` of the point-based discretisation (the stiffness of the
+//! the linear gravity sag `K u = m g` of the library's discretisation (the stiffness of the
 //! energy the step integrates, sparse direct solve), relative L2 against P2 on the same mesh.
 //!
 //! ```text
 //! cargo run --release --example static_accuracy -- [--neighbours K] [--hourglass C]
-//!     [--nodal-volume] [--dual-cells] [--tetrahedra] [--plain-mls] [--audit] [--tet-schemes] [--nu 0.3,0.45,...] [SCENE ...]
+//!     [--nodal-volume] [--particles] [--tet-volumes] [--paper] [--plain-mls] [--audit] [--tet-schemes]
+//!     [--nu 0.3,0.45,...] [SCENE ...]
 //! ```
 //! The reference is P2 (displacement) below ν 0.45 and Taylor–Hood (mixed P2/P1,
 //! `*_th.csv`) from 0.45 up, where displacement-only P2 locks too (validation/README.md g).
-//! `--dual-cells`: one volume constraint per particle on its dual cell instead of one per
-//! tetrahedron (`VolumeScheme::DualCells`). `--tetrahedra`: the elasticity on corotated
-//! linear tetrahedra instead of the particles (`ElasticScheme::Tetrahedra`).
+//! Without options: the default settings (the elasticity on corotated linear tetrahedra, one
+//! volume constraint per particle on its dual cell). `--particles`: the elasticity on the
+//! paper's point-based particles (`ElasticScheme::PointBased`). `--tet-volumes`: one volume
+//! constraint per tetrahedron (`VolumeScheme::Tetrahedra`). `--paper`: both, the paper's
+//! method. `--nodal-volume`: no volume constraints (the elasticity carries λ).
 //! `--tet-schemes` adds columns for tetrahedral discretisations on the same nodes (assembled
 //! in `tet_schemes.rs`): linear tets (a check of the assembly against the reference's P1
 //! column), linear tets with the volumetric energy on the nodes' dual cells (the average nodal
@@ -239,9 +242,12 @@ fn main() -> Res<()> {
             "--neighbours" => options.target_neighbours = args.next().ok_or("K")?.parse()?,
             "--hourglass" => settings.hourglass_stiffness = args.next().ok_or("C")?.parse()?,
             "--nodal-volume" => settings.volume_constraints = false,
-            "--tet-volume" => settings.volume_constraints = true,
-            "--dual-cells" => settings.volume_scheme = tissuesim::VolumeScheme::DualCells,
-            "--tetrahedra" => settings.elastic_scheme = tissuesim::ElasticScheme::Tetrahedra,
+            "--particles" => settings.elastic_scheme = tissuesim::ElasticScheme::PointBased,
+            "--tet-volumes" => settings.volume_scheme = tissuesim::VolumeScheme::Tetrahedra,
+            "--paper" => {
+                settings.elastic_scheme = tissuesim::ElasticScheme::PointBased;
+                settings.volume_scheme = tissuesim::VolumeScheme::Tetrahedra;
+            }
             "--plain-mls" => options.consistent_gradients = false,
             "--audit" => with_audit = true,
             "--tet-schemes" => with_schemes = true,
@@ -255,11 +261,11 @@ fn main() -> Res<()> {
     }
     if with_schemes {
         println!(
-            "scene | point-based vs reference | P1 vs reference | P1 assembled here | \
+            "scene | tissuesim vs reference | P1 vs reference | P1 assembled here | \
              tets + dual cells | faces + dual cells | edges + dual cells"
         );
     } else {
-        println!("scene | point-based vs reference | P1 vs reference");
+        println!("scene | tissuesim vs reference | P1 vs reference");
     }
     for scene in scenes(&names, &ratios)? {
         let Ok(reference) = read_reference(&scene.reference) else {

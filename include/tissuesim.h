@@ -202,7 +202,9 @@ typedef struct ts_settings {
      */
     uint32_t contact_mode;
     /**
-     * Per-tetrahedron volume constraints: 0 off, non-zero on.
+     * Volume constraints, one per particle on its dual cell (the elasticity on corotated
+     * tetrahedra keeps the volumetric stiffness up to lambda = 1.5 mu, the constraints take
+     * the rest): 0 off, non-zero on (the default). The C API runs the default schemes only.
      */
     uint8_t volume_constraints;
     /**

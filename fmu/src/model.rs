@@ -132,8 +132,8 @@ crate::fmi2_variables! {
         TOOL_RADIUS = param("tool_radius", Fixed, "m", 0.01, Some(0.0), "Tool radius (sphere, capsule, cylinder) or half width (box)"),
         TOOL_HALF_LENGTH = param("tool_half_length", Fixed, "m", 0.03, Some(0.0), "Half length of a capsule, cylinder or box along the tool's local y axis"),
         INTERNAL_STEP = param("internal_step", Tunable, "s", 1.0e-3, Some(0.0), "Largest internal time step: fmi2DoStep(h) runs ceil(h/internal_step) world steps of equal length"),
-        VOLUME_COMPLIANCE = param("volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Extra compliance of the per-tetrahedron volume constraints, added to the material's 1/lambda; 0 = the material's own compressibility"),
-        VOLUME_CONSTRAINTS = Variable::boolean("volume_constraints", Parameter, Tunable, true, "Enable the per-tetrahedron volume constraints"),
+        VOLUME_COMPLIANCE = param("volume_compliance", Tunable, "1/Pa", 0.0, Some(0.0), "Extra compliance of the volume constraints (one per particle's dual cell), added to what the material gives them; 0 = the material's own compressibility"),
+        VOLUME_CONSTRAINTS = Variable::boolean("volume_constraints", Parameter, Tunable, true, "Enable the volume constraints (one per particle's dual cell)"),
         MESH = Variable::string("mesh", Parameter, Fixed, DEFAULT_MESH, "Organ mesh: a file in the FMU's resources/ or an absolute path (.msh, .node/.ele, .vtk); empty = the embedded default organ"),
         MESH_SCALE = param("mesh_scale", Fixed, "", 1.0, Some(0.0), "Factor from mesh units to metres"),
         FIXED_MIN_X = param("fixed_min_x", Fixed, "m", DEFAULT_FIXED_MIN[0], None, "Lower corner x of the box whose nodes are fixed (empty box: none)"),
@@ -198,7 +198,7 @@ const STATE_SIM: u8 = 1;
 
 impl Model for TissueSim {
     const MODEL_IDENTIFIER: &'static str = "TissueSim";
-    const DESCRIPTION: &'static str = "Real-time soft-tissue solver (point-based elasticity, position-based contact and volume conservation): a kinematic tool pressing an organ; inputs tool pose, outputs contact force/torque and organ volume";
+    const DESCRIPTION: &'static str = "Real-time soft-tissue solver (corotated elasticity, position-based contact and volume conservation): a kinematic tool pressing an organ; inputs tool pose, outputs contact force/torque and organ volume";
     const VARIABLES: &'static [Variable] = VARIABLES;
     const UNITS: &'static [UnitDefinition] = UNITS;
     const ENUMERATIONS: &'static [&'static EnumType] = &[&TOOL_SHAPE_TYPE];

@@ -42,7 +42,7 @@ RETRACTION = 0.03
 """How far (m) the grasped tissue must be pulled out along +z."""
 MAX_SPEED = 0.05
 """Largest grasper speed per axis (m/s)."""
-MAX_FORCE = 3.0
+MAX_FORCE = 4.0
 """The grasp slips beyond this pull (N)."""
 SOLVER_STEPS = 10
 """Solver steps (1 ms each) per env step."""
@@ -57,7 +57,7 @@ class RetractEnv(_Base):
 
     def __init__(self) -> None:
         if spaces is not None:
-            # Displacements within ±1 m, forces within ±100 N (the grasp slips at 3 N).
+            # Displacements within ±1 m, forces within ±100 N (the grasp slips at 4 N).
             high = np.array([1.0, 1.0, 1.0, 100.0, 100.0, 100.0], dtype=np.float32)
             self.observation_space = spaces.Box(-high, high, dtype=np.float32)
             self.action_space = spaces.Box(-MAX_SPEED, MAX_SPEED, shape=(3,), dtype=np.float32)

@@ -37,9 +37,9 @@ impl From<tissuesim::ContactMode> for ContactMode {
 #[pyclass(module = "tissuesim", eq, eq_int, from_py_object)]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum VolumeScheme {
-    /// One constraint per tetrahedron (the paper's; the default).
+    /// One constraint per tetrahedron (the paper's): locks like linear tetrahedra as nu -> 0.5.
     Tetrahedra,
-    /// One constraint per particle on its dual cell: does not lock as nu -> 0.5.
+    /// One constraint per particle on its dual cell (the default): does not lock as nu -> 0.5.
     DualCells,
 }
 
@@ -65,9 +65,9 @@ impl From<tissuesim::VolumeScheme> for VolumeScheme {
 #[pyclass(module = "tissuesim", eq, eq_int, from_py_object)]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum ElasticScheme {
-    /// The paper's point-based particles (MLS deformation gradient; the default).
+    /// The paper's point-based particles (MLS deformation gradient).
     PointBased,
-    /// Corotated linear tetrahedra of the mesh.
+    /// Corotated linear tetrahedra of the mesh (the default).
     Tetrahedra,
 }
 
@@ -170,9 +170,9 @@ pub struct Settings {
     pub volume_constraints: bool,
     /// With volume constraints: lambda carried by them (compliance 1/lambda). Default True.
     pub volumetric_split: bool,
-    /// What each volume constraint keeps. Default VolumeScheme.Tetrahedra.
+    /// What each volume constraint keeps. Default VolumeScheme.DualCells.
     pub volume_scheme: VolumeScheme,
-    /// What carries the elasticity. Default ElasticScheme.PointBased.
+    /// What carries the elasticity. Default ElasticScheme.Tetrahedra.
     pub elastic_scheme: ElasticScheme,
     /// Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0.
     pub volume_compliance: Real,

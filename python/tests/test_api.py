@@ -151,14 +151,14 @@ def test_settings_mirror_every_rust_field():
         assert f"{f}=" in repr(s)
     assert s.dt == 1e-3 and s.gravity == [0.0, -9.81, 0.0]
     assert s.contact_mode == ts.ContactMode.ExactShape
-    assert s.volume_scheme == ts.VolumeScheme.Tetrahedra
-    assert s.elastic_scheme == ts.ElasticScheme.PointBased
+    assert s.volume_scheme == ts.VolumeScheme.DualCells
+    assert s.elastic_scheme == ts.ElasticScheme.Tetrahedra
     custom = ts.Settings(
         dt=5e-4,
         threads=2,
         contact_mode=ts.ContactMode.SampledPoints,
-        volume_scheme=ts.VolumeScheme.DualCells,
-        elastic_scheme=ts.ElasticScheme.Tetrahedra,
+        volume_scheme=ts.VolumeScheme.Tetrahedra,
+        elastic_scheme=ts.ElasticScheme.PointBased,
         divergence=ts.DivergenceLimits(max_speed=100.0),
     )
     world = ts.World(custom)

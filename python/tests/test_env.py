@@ -59,5 +59,5 @@ def test_pulling_too_hard_tears_the_tissue_loose(env):
         obs, reward, terminated, truncated, info = env.step(np.array([0.05, 0, 0], np.float32))
         if terminated or truncated:
             break
-    # Dragging the tissue sideways at full speed pulls beyond the grasp's 3 N: it slips.
+    # Dragging the tissue sideways at full speed pulls beyond the grasp's 4 N: it slips.
     assert terminated and info["held"] == 0 and reward == -10.0

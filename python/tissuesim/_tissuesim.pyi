@@ -77,17 +77,17 @@ class VolumeScheme(enum.Enum):
     """What one volume constraint keeps."""
 
     Tetrahedra = 0
-    """One constraint per tetrahedron (the paper's; the default)."""
+    """One constraint per tetrahedron (the paper's): locks like linear tetrahedra as ν → 0.5."""
     DualCells = 1
-    """One constraint per particle on its dual cell: does not lock as ν → 0.5."""
+    """One constraint per particle on its dual cell (the default): does not lock as ν → 0.5."""
 
 class ElasticScheme(enum.Enum):
     """What carries the elasticity."""
 
     PointBased = 0
-    """The paper's point-based particles (MLS deformation gradient; the default)."""
+    """The paper's point-based particles (MLS deformation gradient)."""
     Tetrahedra = 1
-    """Corotated linear tetrahedra of the mesh; with DualCells they do not lock as ν → 0.5."""
+    """Corotated linear tetrahedra (the default); with DualCells they do not lock as ν → 0.5."""
 
 class DivergenceLimits:
     """Bounds beyond which a step is rolled back (relative to the body's rest size, the
@@ -138,9 +138,9 @@ class Settings:
     volumetric_split: bool
     """With volume constraints: λ carried by them (compliance 1/λ). Default True."""
     volume_scheme: VolumeScheme
-    """What each volume constraint keeps. Default VolumeScheme.Tetrahedra."""
+    """What each volume constraint keeps. Default VolumeScheme.DualCells."""
     elastic_scheme: ElasticScheme
-    """What carries the elasticity. Default ElasticScheme.PointBased."""
+    """What carries the elasticity. Default ElasticScheme.Tetrahedra."""
     volume_compliance: float
     """Extra compliance of the volume constraints (1/Pa, per unit volume). Default 0."""
     iterations: int

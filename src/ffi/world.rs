@@ -55,7 +55,9 @@ pub struct ts_settings {
     pub iterations: u32,
     /// How tool-tissue contact is detected: a ts_contact_mode value.
     pub contact_mode: u32,
-    /// Per-tetrahedron volume constraints: 0 off, non-zero on.
+    /// Volume constraints, one per particle on its dual cell (the elasticity on corotated
+    /// tetrahedra keeps the volumetric stiffness up to lambda = 1.5 mu, the constraints take
+    /// the rest): 0 off, non-zero on (the default). The C API runs the default schemes only.
     pub volume_constraints: u8,
     /// Surface self-contact: each body's boundary vertices kept a skin of half a particle
     /// radius in front of its own boundary triangles, so that folds and the faces of a cut do

@@ -26,14 +26,16 @@ pub enum ContactMode {
 pub enum ElasticScheme {
     /// The paper's point-based elasticity: a moving-least-squares deformation gradient per
     /// particle, nodal integration with hourglass control (`crate::kernels::point_elasticity`).
-    /// The default.
+    /// Selectable; too soft by 14–24% on coarse meshes at ν 0.3 (docs/VALIDATION.md).
     PointBased,
     /// Corotated linear tetrahedra: one deformation gradient and rotation per tetrahedron of
     /// the mesh, the same corotated stress (`crate::kernels::tet_elasticity`); no zero-energy
     /// modes, so no hourglass control. The particles stay the unknowns; contact, volume
     /// constraints and everything else are unchanged. With the volume constraints on, a crush
     /// guard keeps every tetrahedron above a tenth of its rest volume (a hard one-sided
-    /// constraint, inactive above it), so that inverted tetrahedra come back.
+    /// constraint, inactive above it), so that inverted tetrahedra come back. The default:
+    /// with [`VolumeScheme::DualCells`] the tetrahedra keep the volumetric stiffness up to
+    /// λ = 1.5 μ (ν 0.3's, where they do not lock) and the dual cells take the rest.
     Tetrahedra,
 }
 
@@ -42,17 +44,16 @@ pub enum ElasticScheme {
 pub enum VolumeScheme {
     /// One constraint per tetrahedron (eq. 13 of the paper): about six constraints per
     /// particle's three unknowns, so nearly incompressible tissue locks as linear tetrahedra do
-    /// (docs/VALIDATION.md). The default.
+    /// (docs/VALIDATION.md). Selectable (the paper's method, with `ElasticScheme::PointBased`).
     Tetrahedra,
     /// One constraint per particle, on its dual cell (a quarter of each tetrahedron around
     /// it): does not lock as ν → 0.5 (at ν 0.49 a quarter to a half of linear tetrahedra's
-    /// static error on the measured meshes, against nearly all of it per tetrahedron), but with
-    /// the particles' shear it is too soft at ν ≤ 0.45, so not yet the default. Projected
-    /// colour by colour on the thread pool (no two cells of a colour share a particle: 31
-    /// colours on liver_4k, 26 on the default organ), the same bits on any thread count. Cost,
-    /// haptic liver_4k with the probe: 1.21 ms median per step on one thread against 0.92 ms
-    /// per tetrahedron (docs/PERFORMANCE.md). With `ElasticScheme::Tetrahedra` it is below
-    /// linear tetrahedra's static error from ν 0.45 up on every measured mesh.
+    /// static error on the measured meshes, against nearly all of it per tetrahedron).
+    /// Projected colour by colour on the thread pool (no two cells of a colour share a
+    /// particle: 31 colours on liver_4k, 26 on the default organ), the same bits on any thread
+    /// count. The default, with `ElasticScheme::Tetrahedra`: below linear tetrahedra's static
+    /// error from ν 0.45 up on every measured mesh (with the particles' shear it is too soft at
+    /// ν ≤ 0.45).
     DualCells,
 }
 
@@ -97,13 +98,14 @@ pub struct Settings {
     /// constraints on, the worst error against FEM over two livers and a beam is flat for
     /// 0.13–0.5 and grows outside it; with the particles carrying λ, 1.0 minimises it.
     pub hourglass_stiffness: Real,
-    /// Enable the XPBD per-tetrahedron volume constraints (eq. 13 of the paper). With them
-    /// (the default) the volumetric stiffness λ is handled implicitly by XPBD, robust under
-    /// contact and for nearly incompressible tissue, but per-tetrahedron constraints lock like
-    /// linear tetrahedra at high ν (a beam ~30% too stiff at ν 0.45). Without them the
-    /// particles carry λ in their stress: the consistent, locking-free discretisation with the
-    /// better static accuracy at ν ≤ 0.45 (docs/VALIDATION.md), not yet the default because
-    /// its explicit bulk stiffness disturbs frictional sliding and settling after a tool jump.
+    /// Enable the XPBD volume constraints (eq. 13 of the paper; what each keeps is
+    /// [`Settings::volume_scheme`]). With them (the default) the volumetric stiffness λ is
+    /// handled implicitly by XPBD, robust under contact and for nearly incompressible tissue.
+    /// Without them the elasticity carries all of λ explicitly: the paper's particles then do
+    /// not lock (docs/VALIDATION.md) but need more added mass and settle slowly after a tool
+    /// jump; on the tetrahedra it is linear tetrahedra's locking response, and their stiff
+    /// explicit bulk term grew unstable under large deformation at the default
+    /// `stability_margin` in our runs (0.5 held). For static studies, not interactive scenes.
     pub volume_constraints: bool,
     /// With volume constraints on: the volumetric (λ) term leaves the particle stress and the
     /// tetrahedron volume constraints carry it, with compliance `1/λ` per unit volume (plus
@@ -115,11 +117,14 @@ pub struct Settings {
     /// of compliance `volume_compliance` on top (0 = hard, which over-constrains a tetrahedral
     /// mesh: more tetrahedra than degrees of freedom).
     pub volumetric_split: bool,
-    /// What each volume constraint keeps: a tetrahedron's volume (the paper's, the default) or
-    /// a particle's dual cell.
+    /// What each volume constraint keeps: a particle's dual cell (the default: about one
+    /// constraint per particle, which does not lock as ν → 0.5) or a tetrahedron's volume (the
+    /// paper's: about six constraints per particle, locking like linear tetrahedra).
     pub volume_scheme: VolumeScheme,
-    /// What carries the elasticity: the paper's point-based particles (the default) or
-    /// corotated linear tetrahedra.
+    /// What carries the elasticity: corotated linear tetrahedra (the default: with dual cells,
+    /// at most linear tetrahedra's static error at every ν and half of it or less from
+    /// ν 0.49 up, docs/VALIDATION.md) or the paper's point-based particles (MLS deformation
+    /// gradients, 1.5–5× linear tetrahedra's error at ν 0.3 on the measured organs).
     pub elastic_scheme: ElasticScheme,
     /// Compliance (1/Pa, per unit volume) the volume constraints get in addition to `1/λ`
     /// under the split, or in total without it (0 = hard constraints).
