@@ -322,8 +322,8 @@ fn main() {
     let mut times_csv: Option<PathBuf> = None;
     let mut scene_name = "haptic".to_string();
     let mut threads = 1;
-    let mut volume_scheme = VolumeScheme::Tetrahedra;
-    let mut elastic_scheme = ElasticScheme::PointBased;
+    let mut volume_scheme = Settings::default().volume_scheme;
+    let mut elastic_scheme = Settings::default().elastic_scheme;
     let mut self_contact = false;
     let mut profile = false;
     let mut args = std::env::args().skip(1);

@@ -220,14 +220,15 @@ pub(crate) const CRUSH_FLOOR_RATIO: Real = 0.1;
 /// adds no stiffness there (no locking). Its list costs nothing (the force pass forms every
 /// `det F`); a tetrahedron that goes from above half its volume to below a tenth within one
 /// substep is lifted at the end of the next one, and one lifted to the floor stays listed.
-/// The listed tetrahedra are projected one by one, on the calling thread in tetrahedron order.
+/// The listed tetrahedra are projected one by one, on the calling thread in the order of the
+/// force pass's elements.
 pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) {
     let elements = &body.model.tet_elements;
     let p = &mut scratch.p;
     let chunks = elements.chunk_count();
     for (c, &bits) in scratch.compressed[..chunks].iter().enumerate() {
         for l in (0..LANES).filter(|l| bits & 1 << l != 0) {
-            let t = LANES * c + l;
+            let t = elements.tet_at(LANES * c + l);
             let corners = elements.corners(t).map(|k| k as usize);
             let x = corners.map(|k| p[k]);
             let w = corners.map(|k| body.inv_mass[k]);
