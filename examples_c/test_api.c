@@ -144,6 +144,56 @@ static void test_profile(double h) {
     ts_world_free(profiled);
 }
 
+/* The settled hanging lattice of a world with the given schemes and hourglass stiffness. */
+static void settled(double h, uint32_t elastic, uint32_t volume, double hourglass, double *x) {
+    ts_settings settings;
+    ts_material material;
+    ts_world *world = NULL;
+    uint32_t body = 0;
+    CHECK_OK(ts_settings_default(&settings));
+    settings.hourglass_stiffness = hourglass;
+    CHECK_OK(ts_material_default(&material));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_OK(ts_world_set_schemes(world, elastic, volume));
+    CHECK_OK(ts_world_add_body_from_arrays(world, nodes, NN, tets, NT, &material, NULL, &body));
+    double lo[3] = {OX - 1, CELLS * h - 0.25 * h, -1}, hi[3] = {OX + 1, 1, 1};
+    CHECK_OK(ts_body_fix_box(world, body, lo, hi, NULL));
+    CHECK_OK(ts_world_settle(world));
+    CHECK_OK(ts_body_positions(world, body, x, 3 * NN));
+    ts_world_free(world);
+}
+
+/* The schemes: the defaults until set, kept by ts_world_set_settings, a bad value refused with
+ * nothing changed; and they select what carries the elasticity: the hourglass stiffness acts on
+ * the paper's particles only (the default's tetrahedra have no zero-energy modes). */
+static void test_schemes(double h) {
+    ts_settings settings;
+    ts_world *world = NULL;
+    ts_schemes s;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_ST(ts_world_schemes(world, NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_world_set_schemes(NULL, 0, 0), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_world_schemes(world, &s));
+    CHECK(s.elastic == TS_ELASTIC_SCHEME_TETRAHEDRA && s.volume == TS_VOLUME_SCHEME_DUAL_CELLS);
+    const uint32_t particles = TS_ELASTIC_SCHEME_POINT_BASED, per_tet = TS_VOLUME_SCHEME_TETRAHEDRA;
+    CHECK_OK(ts_world_set_schemes(world, particles, per_tet));
+    CHECK_ST(ts_world_set_schemes(world, 7, per_tet), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_world_set_schemes(world, particles, 2), TS_STATUS_INVALID_ARGUMENT);
+    settings.iterations = 2;
+    CHECK_OK(ts_world_set_settings(world, &settings));
+    CHECK_OK(ts_world_schemes(world, &s));
+    CHECK(s.elastic == TS_ELASTIC_SCHEME_POINT_BASED && s.volume == TS_VOLUME_SCHEME_TETRAHEDRA);
+    ts_world_free(world);
+    static double a[3 * NN], b[3 * NN];
+    settled(h, TS_ELASTIC_SCHEME_TETRAHEDRA, TS_VOLUME_SCHEME_DUAL_CELLS, 0.25, a);
+    settled(h, TS_ELASTIC_SCHEME_TETRAHEDRA, TS_VOLUME_SCHEME_DUAL_CELLS, 1.0, b);
+    CHECK(memcmp(a, b, sizeof a) == 0);
+    settled(h, TS_ELASTIC_SCHEME_POINT_BASED, TS_VOLUME_SCHEME_TETRAHEDRA, 0.25, a);
+    settled(h, TS_ELASTIC_SCHEME_POINT_BASED, TS_VOLUME_SCHEME_TETRAHEDRA, 1.0, b);
+    CHECK(memcmp(a, b, sizeof a) != 0);
+}
+
 /* The functions that cover the rest of the Rust API: body state, fixed flags, particle radius,
  * pair and tool friction, convex-hull and triangle-array tools, removing a tool, and a capsule
  * of half-height 0 (a sphere). Uses the lattice of build_lattice (edge CELLS * h). */
@@ -502,6 +552,7 @@ int main(void) {
     build_lattice(h);
     test_settle(h);
     test_profile(h);
+    test_schemes(h);
     test_coverage(h);
     test_grasp(h);
     test_needle(h);

@@ -139,6 +139,38 @@ typedef enum ts_contact_mode {
 } ts_contact_mode;
 
 /**
+ * What carries the elasticity.
+ */
+typedef enum ts_elastic_scheme {
+    /**
+     * Corotated linear tetrahedra of the mesh (the default).
+     */
+    TS_ELASTIC_SCHEME_TETRAHEDRA = 0,
+    /**
+     * The paper's point-based particles (moving-least-squares deformation gradients): about
+     * 0.75x the default's step cost, too soft on coarse meshes, locking near nu 0.5 with
+     * per-tetrahedron volume constraints.
+     */
+    TS_ELASTIC_SCHEME_POINT_BASED = 1,
+} ts_elastic_scheme;
+
+/**
+ * What one volume constraint keeps.
+ */
+typedef enum ts_volume_scheme {
+    /**
+     * A particle's dual cell, about one constraint per particle (the default): does not lock
+     * as nu -> 0.5.
+     */
+    TS_VOLUME_SCHEME_DUAL_CELLS = 0,
+    /**
+     * A tetrahedron, about six constraints per particle (the paper's): locks like linear
+     * tetrahedra as nu -> 0.5.
+     */
+    TS_VOLUME_SCHEME_TETRAHEDRA = 1,
+} ts_volume_scheme;
+
+/**
  * A simulated scene: bodies, tools and settings. Opaque; made by ts_world_new, released by
  * ts_world_free. Used by one thread at a time; different worlds are independent.
  */
@@ -204,7 +236,7 @@ typedef struct ts_settings {
     /**
      * Volume constraints, one per particle on its dual cell (the elasticity on corotated
      * tetrahedra keeps the volumetric stiffness up to lambda = 1.5 mu, the constraints take
-     * the rest): 0 off, non-zero on (the default). The C API runs the default schemes only.
+     * the rest; ts_world_set_schemes selects others): 0 off, non-zero on (the default).
      */
     uint8_t volume_constraints;
     /**
@@ -501,6 +533,20 @@ typedef struct ts_step_profile {
     double total;
 } ts_step_profile;
 
+/**
+ * A world's schemes: a ts_elastic_scheme and a ts_volume_scheme value.
+ */
+typedef struct ts_schemes {
+    /**
+     * What carries the elasticity: a ts_elastic_scheme value.
+     */
+    uint32_t elastic;
+    /**
+     * What one volume constraint keeps: a ts_volume_scheme value.
+     */
+    uint32_t volume;
+} ts_schemes;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -585,7 +631,8 @@ void ts_world_free(struct ts_world *world);
 enum ts_status ts_world_get_settings(const struct ts_world *world, struct ts_settings *out);
 
 /**
- * Replace the settings (validated as in ts_world_new; the world is unchanged on error).
+ * Replace the settings (validated as in ts_world_new; the world is unchanged on error). The
+ * world keeps its schemes (ts_world_set_schemes), which ts_settings does not carry.
  *
  * # Safety
  *
@@ -1552,6 +1599,29 @@ enum ts_status ts_world_set_profiling(struct ts_world *world, uint32_t on);
  */
 enum ts_status ts_world_step_profile(const struct ts_world *world,
                                      struct ts_step_profile *out_profile);
+
+/**
+ * Select what carries the elasticity (`elastic`, a ts_elastic_scheme value) and what each
+ * volume constraint keeps (`volume`, a ts_volume_scheme value) for every body of the world,
+ * from the next step on; TS_ELASTIC_SCHEME_POINT_BASED with TS_VOLUME_SCHEME_TETRAHEDRA is the
+ * paper's method. The bodies re-derive their stability limit and mass scaling, as a change of
+ * settings does. A value that is not of its enum returns TS_STATUS_INVALID_ARGUMENT and
+ * changes nothing.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_set_schemes(struct ts_world *world, uint32_t elastic, uint32_t volume);
+
+/**
+ * Write the world's schemes into *out_schemes (the defaults until ts_world_set_schemes).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_schemes` is NULL or writable.
+ */
+enum ts_status ts_world_schemes(const struct ts_world *world, struct ts_schemes *out_schemes);
 
 #ifdef __cplusplus
 }  // extern "C"

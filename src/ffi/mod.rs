@@ -58,11 +58,14 @@ pub mod render;
 
 pub mod profile;
 
+pub mod scheme;
+
 pub use body::{ts_body_options, ts_material};
 pub use cut::ts_cut_report;
 pub use grasp::ts_grasp_options;
 pub use needle::{ts_needle_options, ts_needle_state};
 pub use profile::ts_step_profile;
+pub use scheme::{ts_elastic_scheme, ts_schemes, ts_volume_scheme};
 pub use status::ts_status;
 pub use tool::{ts_pose, ts_tool_options, ts_wrench};
 pub use world::{ts_contact_mode, ts_settings, ts_step_report, ts_world};

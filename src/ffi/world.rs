@@ -57,7 +57,7 @@ pub struct ts_settings {
     pub contact_mode: u32,
     /// Volume constraints, one per particle on its dual cell (the elasticity on corotated
     /// tetrahedra keeps the volumetric stiffness up to lambda = 1.5 mu, the constraints take
-    /// the rest): 0 off, non-zero on (the default). The C API runs the default schemes only.
+    /// the rest; ts_world_set_schemes selects others): 0 off, non-zero on (the default).
     pub volume_constraints: u8,
     /// Surface self-contact: each body's boundary vertices kept a skin of half a particle
     /// radius in front of its own boundary triangles, so that folds and the faces of a cut do
@@ -305,7 +305,8 @@ pub unsafe extern "C" fn ts_world_get_settings(
     })
 }
 
-/// Replace the settings (validated as in ts_world_new; the world is unchanged on error).
+/// Replace the settings (validated as in ts_world_new; the world is unchanged on error). The
+/// world keeps its schemes (ts_world_set_schemes), which ts_settings does not carry.
 ///
 /// # Safety
 ///
@@ -321,7 +322,14 @@ pub unsafe extern "C" fn ts_world_set_settings(
         let h = unsafe { world_mut(world)? };
         // SAFETY: checked non-NULL; readable by contract.
         let s = unsafe { *settings }.to_settings()?;
-        h.mutate(|w| w.set_settings(s))
+        // The schemes are not in ts_settings: the world keeps its own (ts_world_set_schemes).
+        h.mutate(|w| {
+            w.set_settings(Settings {
+                elastic_scheme: w.settings().elastic_scheme,
+                volume_scheme: w.settings().volume_scheme,
+                ..s
+            })
+        })
     })
 }
 
