@@ -24,8 +24,8 @@ use crate::fmi2::{
 use std::path::{Path, PathBuf};
 use tissuesim::Quat;
 use tissuesim::{
-    mesh, BodyId, BodyOptions, Error, GraspOptions, Material, NeedleOptions, Pose, Settings,
-    ToolId, ToolOptions, ToolShape, Vec3, World,
+    mesh, BodyId, BodyOptions, ElasticScheme, Error, GraspOptions, Material, NeedleOptions, Pose,
+    Settings, ToolId, ToolOptions, ToolShape, Vec3, VolumeScheme, World,
 };
 
 /// Default tool position (m): ~1.7 cm in front (+z) of the default organ's right lobe at
@@ -65,6 +65,42 @@ pub static TOOL_SHAPE_TYPE: EnumType = EnumType {
             name: "box",
             value: 3,
             description: "box of half extents (tool_radius, tool_half_length, tool_radius)",
+        },
+    ],
+};
+
+/// The elastic schemes (`elastic_scheme`), numbered as the C API's `ts_elastic_scheme`.
+pub static ELASTIC_SCHEME_TYPE: EnumType = EnumType {
+    name: "ElasticScheme",
+    description: "Discretisation of the organ's elasticity",
+    items: &[
+        EnumItem {
+            name: "tetrahedra",
+            value: 0,
+            description: "corotated linear tetrahedra (the default)",
+        },
+        EnumItem {
+            name: "point_based",
+            value: 1,
+            description: "the paper's point-based particles (MLS deformation gradients)",
+        },
+    ],
+};
+
+/// The volume schemes (`volume_scheme`), numbered as the C API's `ts_volume_scheme`.
+pub static VOLUME_SCHEME_TYPE: EnumType = EnumType {
+    name: "VolumeScheme",
+    description: "Where the volume constraints sit",
+    items: &[
+        EnumItem {
+            name: "dual_cells",
+            value: 0,
+            description: "one constraint per particle on its dual cell (the default)",
+        },
+        EnumItem {
+            name: "tetrahedra",
+            value: 1,
+            description: "one constraint per tetrahedron (the paper's)",
         },
     ],
 };
@@ -152,6 +188,10 @@ crate::fmi2_variables! {
         NEEDLE_PUNCTURE_FORCE = param("needle_puncture_force", Fixed, "N", 0.0, Some(0.0), "Above 0 the tool (a capsule or cylinder; shaft along its local y, tip at +y) is a needle: it punctures the organ when the tissue pushes back on its tip with this force, then holds the tissue on its shaft with friction (World::make_needle); 0 = an ordinary tool"),
         NEEDLE_FRICTION = param("needle_friction", Fixed, "N/m", 10.0, Some(0.0), "Axial friction of an inserted needle per metre of inserted length"),
         NEEDLE_DEPTH = output("needle_depth", "m", "How far the needle's tip is past its entry point along the shaft at the end of the step (0 before puncture, after withdrawal, or when the tool is not a needle)"),
+        ELASTIC_SCHEME = Variable::enumeration("elastic_scheme", Parameter, Fixed, &ELASTIC_SCHEME_TYPE, 0, "Elasticity: 0 corotated tetrahedra (the default), 1 the paper's point-based particles"),
+        VOLUME_SCHEME = Variable::enumeration("volume_scheme", Parameter, Fixed, &VOLUME_SCHEME_TYPE, 0, "Volume constraints: 0 one per particle's dual cell (the default), 1 one per tetrahedron (the paper's)"),
+        DAMPING_STIFFNESS = param("damping_stiffness", Tunable, "s", 0.0, Some(0.0), "Stiffness-proportional damping time beta (Kelvin-Voigt on the tetrahedra, pair dashpots on the particles); explicit, so it can add substeps"),
+        MIN_SUBSTEPS = Variable::integer("min_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps per internal step (more where the stability limit or a fast tool needs them)"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -201,7 +241,8 @@ impl Model for TissueSim {
     const DESCRIPTION: &'static str = "Real-time soft-tissue solver (corotated elasticity, position-based contact and volume conservation): a kinematic tool pressing an organ; inputs tool pose, outputs contact force/torque and organ volume";
     const VARIABLES: &'static [Variable] = VARIABLES;
     const UNITS: &'static [UnitDefinition] = UNITS;
-    const ENUMERATIONS: &'static [&'static EnumType] = &[&TOOL_SHAPE_TYPE];
+    const ENUMERATIONS: &'static [&'static EnumType] =
+        &[&TOOL_SHAPE_TYPE, &ELASTIC_SCHEME_TYPE, &VOLUME_SCHEME_TYPE];
     const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
         start_time: 0.0,
         stop_time: 1.0,
@@ -479,6 +520,16 @@ fn settings_from(store: &Store, base: &Settings, dt: f64) -> Settings {
     s.volume_compliance = store.real(vr::VOLUME_COMPLIANCE);
     s.volume_constraints = store.boolean(vr::VOLUME_CONSTRAINTS);
     s.threads = store.integer(vr::THREADS).clamp(1, 64) as u32;
+    s.elastic_scheme = match store.integer(vr::ELASTIC_SCHEME) {
+        1 => ElasticScheme::PointBased,
+        _ => ElasticScheme::Tetrahedra,
+    };
+    s.volume_scheme = match store.integer(vr::VOLUME_SCHEME) {
+        1 => VolumeScheme::Tetrahedra,
+        _ => VolumeScheme::DualCells,
+    };
+    s.damping_stiffness = store.real(vr::DAMPING_STIFFNESS);
+    s.min_substeps = store.integer(vr::MIN_SUBSTEPS).clamp(1, 64) as u32;
     s
 }
 
