@@ -16,12 +16,24 @@ use tissuesim::{
     WorldState,
 };
 
-/// How far past first contact the probe is pressed (m).
-const PRESS: Real = 0.03;
-/// Press and withdrawal speed (m/s).
-const SPEED: Real = 0.05;
-/// How long the probe is held at full depth (s).
-const HOLD: Real = 0.5;
+/// A press: how far past first contact (m), at what speed in and out (m/s), held how long at
+/// full depth (s), under which settings.
+struct Plan {
+    depth: Real,
+    speed: Real,
+    hold: Real,
+    settings: Settings,
+}
+
+/// The presses of the goal: 3 cm at 5 cm/s, held 0.5 s, default settings.
+fn three_cm() -> Plan {
+    Plan {
+        depth: 0.03,
+        speed: 0.05,
+        hold: 0.5,
+        settings: Settings::default(),
+    }
+}
 /// The most of a probe's radius the surface may get inside it (the contact goal).
 const MOST_INSIDE: Real = 0.2;
 
@@ -62,6 +74,8 @@ struct Press {
     pulling: usize,
     /// Steps of the press and hold in contact.
     contact_steps: usize,
+    /// Steps of the press and hold.
+    pressing_steps: usize,
 }
 
 /// Depth (m) of the body's boundary surface inside a sphere at `centre` of `radius`: the
@@ -82,15 +96,15 @@ fn surface_depth(body: &Body, centre: &Vec3, radius: Real) -> Real {
 
 /// Press `probe`, which reaches `radius` (m) from its centre along the press, along the
 /// horizontal unit `direction` on the line through `through` (m), from 2 mm off the contact
-/// skin, [`PRESS`] past it, hold, withdraw. The surface's depth is measured against the sphere
+/// skin, `plan.depth` past it, hold, withdraw. The surface's depth is measured against the sphere
 /// of `radius` about the probe's centre (the probe itself for a sphere).
 fn press(
     organ: &Hanging,
+    plan: &Plan,
     (probe, radius): (ToolShape, Real),
-    direction: Vec3,
-    through: Vec3,
+    (direction, through): (Vec3, Vec3),
 ) -> Press {
-    let mut world = World::new(Settings::default()).unwrap();
+    let mut world = World::new(plan.settings.clone()).unwrap();
     let body = world.add_body_model(organ.model.clone());
     world.set_state(&organ.state).unwrap();
     let gap = 0.002;
@@ -101,18 +115,19 @@ fn press(
         .add_tool(probe, Pose::at(start), &ToolOptions::default())
         .unwrap();
     let dt = world.settings().dt;
-    let press_steps = ((gap + PRESS) / SPEED / dt).round() as usize;
-    let hold_steps = (HOLD / dt).round() as usize;
+    let press_steps = ((gap + plan.depth) / plan.speed / dt).round() as usize;
+    let hold_steps = (plan.hold / dt).round() as usize;
     let total = 2 * press_steps + hold_steps;
     let mut result = Press {
         deepest: Real::NEG_INFINITY,
         centre_inside: 0,
         pulling: 0,
         contact_steps: 0,
+        pressing_steps: press_steps + hold_steps,
     };
     for k in 1..=total {
         let along = k.min(press_steps).min(total - k) as Real;
-        let centre = start + direction * (SPEED * dt * along);
+        let centre = start + direction * (plan.speed * dt * along);
         world.set_tool_pose(tool, Pose::at(centre)).unwrap();
         world.step().unwrap();
         result.deepest =
@@ -151,20 +166,28 @@ fn check(radii: &[Real], goal: &str, fails: impl Fn(Real, &Press) -> bool) {
         .iter()
         .map(|&radius| (ToolShape::Sphere { radius }, radius))
         .collect();
-    check_probes(&spheres, goal, fails);
+    check_probes(&three_cm(), &spheres, goal, fails);
 }
 
 /// Every press of every probe (its shape and its reach along the press, m) from every side;
 /// panics listing those for which `fails` holds, under the heading `goal`.
-fn check_probes(probes: &[(ToolShape, Real)], goal: &str, fails: impl Fn(Real, &Press) -> bool) {
+fn check_probes(
+    plan: &Plan,
+    probes: &[(ToolShape, Real)],
+    goal: &str,
+    fails: impl Fn(Real, &Press) -> bool,
+) {
     let organ = hanging_organ();
     let mut failures = Vec::new();
     for (probe, radius) in probes.iter().cloned() {
         for (side, direction, through) in sides(&organ) {
-            let p = press(&organ, (probe.clone(), radius), direction, through);
+            let p = press(&organ, plan, (probe.clone(), radius), (direction, through));
             let what = format!("{probe:?}, pressed along {side}: {p:?}");
             eprintln!("{what}");
-            assert!(p.contact_steps > 500, "{what}: the probe barely touched");
+            assert!(
+                p.contact_steps * 5 > p.pressing_steps * 2,
+                "{what}: the probe barely touched"
+            );
             if fails(radius, &p) {
                 failures.push(what);
             }
@@ -195,6 +218,7 @@ fn spheres_of_1_to_10_mm_pressed_3_cm_from_four_sides_stay_outside() {
 fn a_capsule_and_a_box_pressed_3_cm_from_four_sides_stay_outside() {
     let r = 0.005;
     check_probes(
+        &three_cm(),
         &[
             (
                 ToolShape::Capsule {
@@ -233,7 +257,48 @@ fn deep_presses_push_back_at_every_contact_step() {
         },
         r,
     ));
-    check_probes(&probes, "a contact step pulling the probe in", |_, p| {
-        p.pulling > 0
-    });
+    check_probes(
+        &three_cm(),
+        &probes,
+        "a contact step pulling the probe in",
+        |_, p| p.pulling > 0,
+    );
+}
+
+/// The settings for presses far past the 3 cm of the goal (docs/SETTINGS.md, "Deep presses"):
+/// two substeps and 0.3 ms of stiffness-proportional damping.
+fn deep_press_settings() -> Settings {
+    Settings {
+        min_substeps: 2,
+        damping_stiffness: 3e-4,
+        ..Settings::default()
+    }
+}
+
+/// A 1 cm probe driven 20 cm into the organ (14–21 cm across) at 0.5 m/s and withdrawn, under
+/// [`deep_press_settings`]: the tissue wraps round the probe and the probe stays outside it
+/// (measured: never inside, the surface 0.43–0.60 mm outside, at the contact skin). Not
+/// asserted: the organ swings off the probe for up to 80 of the 404 pressing steps, and 8–56
+/// contact steps (−z, +z, −x) have a forward component as the swinging tissue drags on the
+/// probe. Under the default settings the
+/// wrapped tissue beside the probe (2–3 cm from its centre, out of contact) starts a growing
+/// oscillation after 5–10 cm (1 to 23 m/s within 30 steps) and the probe ends inside on
+/// 250–680 of the 816 steps; two substeps alone diverge on two sides, 0.3 ms of damping alone
+/// (one substep) does not hold, and 0.1 ms with two substeps does not either.
+#[test]
+fn a_one_centimetre_probe_pressed_20_cm_stays_outside_with_the_deep_press_settings() {
+    let plan = Plan {
+        depth: 0.2,
+        speed: 0.5,
+        hold: 0.0,
+        settings: deep_press_settings(),
+    };
+    let radius = 0.01;
+    check_probes(
+        &plan,
+        &[(ToolShape::Sphere { radius }, radius)],
+        "the probe's centre inside the organ, or the surface more than a fifth of the radius \
+         inside it, on a 20 cm press",
+        |radius, p| p.centre_inside > 0 || p.deepest > MOST_INSIDE * radius,
+    );
 }
