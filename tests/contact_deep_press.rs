@@ -266,7 +266,8 @@ fn deep_presses_push_back_at_every_contact_step() {
 }
 
 /// The settings for presses far past the 3 cm of the goal (docs/SETTINGS.md, "Deep presses"):
-/// two substeps and 0.3 ms of stiffness-proportional damping.
+/// two substeps and 0.3 ms of stiffness-proportional damping (whose stability limit makes the
+/// two three on the default organ).
 fn deep_press_settings() -> Settings {
     Settings {
         min_substeps: 2,
@@ -280,11 +281,11 @@ fn deep_press_settings() -> Settings {
 /// (measured: never inside, the surface 0.43–0.60 mm outside, at the contact skin). Not
 /// asserted: the organ swings off the probe for up to 80 of the 404 pressing steps, and 8–56
 /// contact steps (−z, +z, −x) have a forward component as the swinging tissue drags on the
-/// probe. Under the default settings the
-/// wrapped tissue beside the probe (2–3 cm from its centre, out of contact) starts a growing
-/// oscillation after 5–10 cm (1 to 23 m/s within 30 steps) and the probe ends inside on
-/// 250–680 of the 816 steps; two substeps alone diverge on two sides, 0.3 ms of damping alone
-/// (one substep) does not hold, and 0.1 ms with two substeps does not either.
+/// probe. Under the default settings tetrahedra under the probe invert, the inverted ones drive
+/// a growing oscillation of the wrapped tissue beside the probe after 5–10 cm (1 to 23 m/s
+/// within 30 steps), and the probe ends inside on 248–680 of the 816 steps; two substeps alone
+/// diverge on two sides, 0.3 ms of damping alone (two substeps) does not hold, and 0.1 ms with
+/// two substeps does not either.
 #[test]
 fn a_one_centimetre_probe_pressed_20_cm_stays_outside_with_the_deep_press_settings() {
     let plan = Plan {
