@@ -142,8 +142,12 @@ impl std::fmt::Debug for SurfaceScratch {
 /// most the tool's own motion along it plus `max_correction` (m), in [`SURFACE_ROUNDS`] rounds of
 /// up to [`MAX_SURFACE_PASSES`] passes (until the largest correction of a pass is below
 /// [`SURFACE_PASS_TOLERANCE`] skins), and accumulate the tool's impulse and moment; `count` adds
-/// the triangles in contact in the first pass of the first round to the tool's contact count. The broad phase runs
-/// on `pool`, each thread flagging its range of triangles; the rest on the calling thread.
+/// the triangles in contact in the first pass of the first round to the tool's contact count;
+/// `retry` (a call after the crush guard, `crate::solver::tool_contact`) keeps a triangle with a
+/// fixed corner within the per-corner budget from the first round on, as the second round
+/// does (without it, a box driven at 2 m/s across the fixed top flung free corners and the step
+/// diverged). The broad phase runs on `pool`, each thread flagging its range of triangles; the
+/// rest on the calling thread.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_tool_surface(
     surface: &mut SurfaceScratch,
@@ -153,7 +157,7 @@ pub(crate) fn project_tool_surface(
     boundary: &[[u32; 3]],
     (prev, cur): (&Pose, &Pose),
     max_correction: Real,
-    count: bool,
+    (count, retry): (bool, bool),
     pool: &Pool,
 ) {
     let iso = cur.isometry();
@@ -259,8 +263,8 @@ pub(crate) fn project_tool_surface(
                 let budget = max_correction + pushed;
                 let mut cap = (budget - moved.dot(&contact.direction)).max(0.0);
                 let shares = corner_shares(&weights, &w);
-                if round > 0 {
-                    // The retry keeps every corner within the budget too.
+                if round > 0 || (retry && w.contains(&0.0)) {
+                    // A retry keeps every corner within the budget too.
                     for k in 0..3 {
                         if shares[k] > 0.0 {
                             let own = view.p[corners[k]] - view.x[corners[k]];

@@ -13,10 +13,8 @@
 //! 2. per substep: [`predict`] (gravity and point-based elastic forces into `force`, then
 //!    `v ← v/(1 + α h) + h f/m`, `p = x + h v`); `Settings::iterations` Gauss–Seidel passes of
 //!    [`volume`] (XPBD tetrahedra), [`organ_contact`] (particle pairs through the hash grid),
-//!    tool contact (each tool against each body, friction, wrench:
-//!    [`surface_contact`] against the boundary triangles, or [`sampled_contact`], the paper's
-//!    tool samples against the particles; off between a needle and the body it punctured and
-//!    between a grasping tool and the body it holds), then the grasps
+//!    [`tool_contact`] (each tool against each body, friction, wrench; on the tetrahedra, the
+//!    crush guard and the contact again while the contact crushes a tetrahedron), then the grasps
 //!    (`crate::grasp`) and needle holds (`crate::needle`); finally `v = (p − x)/h`, `x = p`;
 //! 3. the divergence check ([`divergence_check`]): a failure puts the rollback copy back
 //!    (`Scene::apply_state`, the code `Scene::set_state` uses after its checks);
@@ -38,6 +36,7 @@ mod predict;
 pub(crate) mod profile;
 pub mod statics;
 mod surface_self_contact;
+mod tool_contact;
 mod volume;
 mod workspace;
 
@@ -46,16 +45,15 @@ pub(crate) use surface_self_contact::SelfContactScratch;
 pub(crate) use workspace::{StepScratch, Workspace};
 
 use crate::error::Error;
-use crate::interaction::{sampled_contact, surface_contact};
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::model::body_model::BodyModel;
 use crate::scene::body::{volume_on, Body};
 use crate::scene::cut::{Blade, CutReport};
 use crate::scene::particles::{ParticleView, ParticleViews};
-use crate::scene::settings::{ContactMode, ElasticScheme, VolumeScheme, MAX_THREADS};
+use crate::scene::settings::{ElasticScheme, VolumeScheme, MAX_THREADS};
 use crate::scene::tool::{Pose, ToolShape, Wrench};
-use crate::scene::{Scene, StepReport, ToolSlot};
+use crate::scene::{Scene, StepReport};
 use crate::solver::divergence_check::ParticleScan;
 use crate::solver::profile::{Profiler, Stage};
 use parry3d_f64::math::Point;
@@ -336,47 +334,15 @@ impl Pipeline {
                 }
                 clock = self.profiler.charge(Stage::SelfContact, clock);
             }
-            let mode = scene.settings.contact_mode;
-            let max_correction = scene.settings.max_depenetration_speed * h;
-            for slot in scene.tools.iter_mut().flatten().filter(|s| !s.blade) {
-                let ToolSlot {
-                    tool,
-                    load,
-                    grasp,
-                    needle,
-                    ..
-                } = slot;
-                let prev = Pose::interpolate(&tool.pose, &tool.target, s_prev);
-                let cur = Pose::interpolate(&tool.pose, &tool.target, s_cur);
-                for (b, (body, scratch)) in scene.bodies.iter().zip(scratch.iter_mut()).enumerate()
-                {
-                    if needle.as_ref().is_some_and(|n| n.passes_through(b)) || grasp.holds(b) {
-                        continue;
-                    }
-                    let motion = (&prev, &cur);
-                    match mode {
-                        ContactMode::ExactShape => surface_contact::project_tool_surface(
-                            &mut self.workspace.surface,
-                            tool,
-                            load,
-                            scratch.view(body),
-                            &body.model.boundary,
-                            motion,
-                            max_correction,
-                            it == 0,
-                            &self.pool,
-                        ),
-                        ContactMode::SampledPoints => sampled_contact::project_sampled_contacts(
-                            tool,
-                            load,
-                            scratch.view(body),
-                            motion,
-                            max_correction,
-                            it == 0,
-                        ),
-                    }
-                }
-            }
+            tool_contact::project_tool_contacts(
+                &mut self.workspace.surface,
+                scene,
+                scratch,
+                (s_prev, s_cur),
+                h,
+                it == 0,
+                &self.pool,
+            );
             clock = self.profiler.charge(Stage::ToolContact, clock);
             for slot in scene.tools.iter_mut().flatten() {
                 if !slot.grasp.attachments.is_empty() {

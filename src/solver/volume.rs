@@ -221,8 +221,9 @@ pub(crate) const CRUSH_FLOOR_RATIO: Real = 0.1;
 /// `det F`); a tetrahedron that goes from above half its volume to below a tenth within one
 /// substep is lifted at the end of the next one, and one lifted to the floor stays listed.
 /// The listed tetrahedra are projected one by one, on the calling thread in the order of the
-/// force pass's elements.
-pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) {
+/// force pass's elements. Returns whether it moved any.
+pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) -> bool {
+    let mut lifted = false;
     let elements = &body.model.tet_elements;
     let p = &mut scratch.p;
     let chunks = elements.chunk_count();
@@ -242,7 +243,9 @@ pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) {
                 for (k, d) in corners.iter().zip(dp) {
                     p[*k] += d;
                 }
+                lifted = true;
             }
         }
     }
+    lifted
 }

@@ -203,21 +203,35 @@ def deep_press(fmu_path, start_values):
                         output=["force_z", "contact_count"])
 
 
-def test_deep_press_settings_keep_a_probe_on_the_tissue_through_a_15_cm_press(fmu_path):
-    """min_substeps and damping_stiffness reach the solver: with two substeps and 0.3 ms of
-    damping (docs/SETTINGS.md, "Deep presses") the probe driven along -z stays in contact and
-    is pushed back at every step from first contact to 15 cm of travel (measured: contact lost
-    first at 18.4 cm, near the organ's far side). With the default settings the tissue beside
-    the probe starts oscillating and the probe falls through after ~7 cm (contact lost at
-    0.185 s), which the suite's geometric test measures on the library
-    (tests/contact_deep_press.rs)."""
-    r = deep_press(fmu_path, {"min_substeps": 2, "damping_stiffness": 3e-4})
+def test_a_probe_stays_on_the_tissue_through_15_cm_of_a_20_cm_press(fmu_path):
+    """The default scene's probe driven 20 cm along -z at 0.5 m/s stays in contact and is pushed
+    back at every step from first contact to 15 cm of travel (measured: contact lost first at
+    17.7 cm, near the organ's far side). Before the crush guard and the contact alternated, the
+    tetrahedra under the probe inverted and it fell through after ~7 cm (contact lost at
+    0.185 s); tests/contact_deep_press.rs measures the geometry on the library."""
+    r = deep_press(fmu_path, {})
     t, count = r["time"], r["contact_count"]
     first = t[np.argmax(count > 0)]
     pressing = (t > first) & (t <= 0.3)
     assert pressing.sum() > 200
     assert np.all(count[pressing] > 0)
     assert np.all(r["force_z"][pressing] > 0.0)
+
+
+def test_substeps_and_stiffness_damping_reach_the_solver(fmu_path, press_result):
+    """min_substeps and damping_stiffness change the run (the same press, other forces), and
+    the probe still presses back."""
+    times = [0.0, 0.3, 0.8, 0.9, 1.2, 1.6]
+    signals = np.array(list(zip(times, [press_z(t) for t in times])),
+                       dtype=[("time", np.double), ("tool_pz", np.double)])
+    pressed = (press_result["time"] > 0.75) & (press_result["time"] < 0.95)
+    default = press_result["force_z"][pressed]
+    for start_values in ({"min_substeps": 2}, {"damping_stiffness": 3e-4}):
+        r = simulate_fmu(fmu_path, start_time=0.0, stop_time=1.6, step_size=H, input=signals,
+                         start_values=start_values, output=FORCE + ["contact_count"])
+        assert np.all(r["force_z"][pressed] > 0.5), start_values
+        assert np.max(np.abs(r["force_z"][pressed] - default)) > 1e-6 * np.max(default), \
+            start_values
 
 
 def test_the_papers_schemes_are_selectable(fmu_path, press_result):
