@@ -64,10 +64,11 @@ fn three_cm() -> Plan {
         settings: Settings::default(),
     }
 }
+
 /// The most of a probe's radius the surface may get inside it (the contact goal).
 const MOST_INSIDE: Real = 0.2;
 
-/// The settled hanging `organ` (its top 15% fixed): its shared model, its positions, and the state of a world
+/// A settled hanging organ: its shared model, its positions, and the state of a world
 /// holding it alone. The state carries what a press continues from (positions, velocities,
 /// the particles' rotations).
 struct Hanging {
@@ -77,6 +78,7 @@ struct Hanging {
     state: WorldState,
 }
 
+/// `organ` with its top 15% fixed, settled under gravity.
 fn hanging_organ(organ: mesh::TetMesh) -> Hanging {
     let mut world = World::new(Settings::default()).unwrap();
     let body = world.add_body(&organ, &BodyOptions::default()).unwrap();

@@ -10,10 +10,10 @@
 //! the probe through the surface (a 1 mm sphere pressed 3 cm into the gmsh kidney: tetrahedra
 //! inverted from 1.9 cm on, the tissue beside the probe at 1 m/s, the probe's centre inside the
 //! organ on 1,159–1,370 of 1,780 steps from every side; two rounds hold it from three). The
-//! guard alone after the contact
-//! pushes the surface into the probe; alternated with the contact, the two converge to moving
-//! the crushed tetrahedron's inner corner away. A round runs only while the guard finds a
-//! tetrahedron below its floor, so a scene that crushes none pays nothing.
+//! guard alone after the contact pushes the surface into the probe; alternated with the
+//! contact, the two converge to moving the crushed tetrahedron's inner corner away. A round
+//! runs only while the guard finds a tetrahedron below its floor, so a scene that crushes none
+//! pays nothing.
 
 use crate::interaction::{sampled_contact, surface_contact};
 use crate::kernels::math::Real;
