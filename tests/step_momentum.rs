@@ -1,5 +1,6 @@
-//! Elastic and volume forces are internal: a free body without gravity or damping conserves
-//! linear and angular momentum.
+//! Elastic and volume forces are internal: a free body without gravity or ambient damping
+//! conserves linear and angular momentum; the stiffness-proportional damping's edge dashpots,
+//! central and opposite, conserve both too.
 
 mod common;
 
@@ -24,16 +25,16 @@ fn momenta(world: &World, id: tissuesim::BodyId) -> (Vec3, Vec3) {
 fn run(volume_constraints: bool) -> ((Vec3, Vec3), (Vec3, Vec3)) {
     run_with(Settings {
         volume_constraints,
+        damping_stiffness: 0.0,
         ..common::paper(Settings::default())
     })
 }
 
-/// [`run`] under `settings` (gravity and damping off).
+/// [`run`] under `settings` (gravity and ambient damping off).
 fn run_with(settings: Settings) -> ((Vec3, Vec3), (Vec3, Vec3)) {
     let settings = Settings {
         gravity: Vec3::zeros(),
         damping_mass: 0.0,
-        damping_stiffness: 0.0,
         ..settings
     };
     let mut world = World::new(settings).unwrap();
@@ -93,9 +94,9 @@ fn volume_constraints_conserve_linear_momentum() {
     assert!((l1 - l0).norm() <= 1e-2 * l0.norm());
 }
 
-/// The default: the tetrahedra's corner forces sum to zero and their torque vanishes; with the
-/// dual cells carrying the volume, linear momentum stays exact and angular momentum changes
-/// only as the volume projections make it (O(h)).
+/// The default: the tetrahedra's corner forces sum to zero and their torque vanishes, and so do
+/// the edge dashpots' impulses; with the dual cells carrying the volume, linear momentum stays
+/// exact and angular momentum changes only as the volume projections make it (O(h)).
 #[test]
 fn tetrahedra_conserve_momentum() {
     let ((p0, l0), (p1, l1)) = run_with(Settings::default());
@@ -108,4 +109,23 @@ fn tetrahedra_conserve_momentum() {
         (l1 - l0).norm() / l0.norm()
     );
     assert!((l1 - l0).norm() <= 1e-2 * l0.norm());
+}
+
+/// The edge dashpots alone with the tetrahedra (no volume constraints): both momenta exact,
+/// under a strong β (5 ms).
+#[test]
+fn stiffness_damping_conserves_linear_and_angular_momentum() {
+    let ((p0, l0), (p1, l1)) = run_with(Settings {
+        volume_constraints: false,
+        damping_stiffness: 5e-3,
+        ..Settings::default()
+    });
+    assert!(
+        (p1 - p0).norm() <= 1e-9 * p0.norm(),
+        "linear momentum drifted from {p0} to {p1}"
+    );
+    assert!(
+        (l1 - l0).norm() <= 1e-6 * l0.norm(),
+        "angular momentum drifted from {l0} to {l1}"
+    );
 }

@@ -130,7 +130,8 @@ class Settings:
     damping_mass: float
     """Mass-proportional damping rate α (1/s). Default 2."""
     damping_stiffness: float
-    """Stiffness-proportional damping time β (s). Default 0."""
+    """Stiffness-proportional damping time β (s): dashpots on the mesh edges, implicit (adds no
+    substeps). Default 0.0003 (0.3 ms)."""
     hourglass_stiffness: float
     """Hourglass-control stiffness (dimensionless, times the shear modulus). Default 0.25."""
     volume_constraints: bool

@@ -25,5 +25,6 @@ pub(crate) mod parallel;
 pub(crate) mod point_elasticity;
 pub(crate) mod rotation;
 pub(crate) mod stability;
+pub(crate) mod tet_dashpots;
 pub(crate) mod tet_elasticity;
 pub(crate) mod vec3_array;

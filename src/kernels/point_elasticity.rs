@@ -1,6 +1,7 @@
 //! The point-based elasticity of the paper (eq. 1–4): MLS deformation gradient, invertible
 //! corotated stress, pairwise forces; plus the two pair terms that keep an explicit particle
-//! solid well behaved: hourglass control and stiffness-proportional damping.
+//! solid well behaved: hourglass control. (Stiffness-proportional damping filters the velocities
+//! after the kick, implicitly, on the mesh edges: [`crate::kernels::tet_dashpots`].)
 //!
 //! Per particle `i` with volume `v_i` (m³):
 //! 1. `F_i = I + Σ_j (x_ij - u_ij) d_ijᵀ` (= `Σ_j x_ij d_ijᵀ`, eq. 1–2, written in displacements
@@ -21,10 +22,6 @@
 //! kernel weight. `ε` is linear in the positions (through `F_i`), zero under any affine motion
 //! and rotation invariant in norm, so its exact gradient is a conservative force that conserves
 //! linear and angular momentum and never pumps energy into the zero-energy modes it removes.
-//!
-//! Damping: a dashpot along each pair, `β k_ij (v_ij·x̂_ij)`, with `k_ij = (λ + 2μ) v_i |d_ij|²`
-//! the pair's elastic stiffness (N/m): stiffness-proportional (Rayleigh β) damping that is
-//! central (momentum conserving) and zero under rigid motion.
 
 use crate::kernels::lanes::{F4, LANES, M4, V4};
 use crate::kernels::math::{Mat3, Quat, Real, Vec3};
@@ -43,7 +40,8 @@ pub struct ElasticModel {
     pub mu: Real,
     /// Hourglass stiffness `c_hg · μ` (Pa).
     pub hourglass: Real,
-    /// Stiffness-proportional damping time β (s).
+    /// Stiffness-proportional damping time β (s), for the edge dashpots of
+    /// [`crate::kernels::tet_dashpots`].
     pub damping_stiffness: Real,
 }
 
@@ -95,8 +93,6 @@ pub struct ForceInputs<'a> {
     pub volume: &'a [Real],
     /// Current positions (m).
     pub x: &'a [Vec3],
-    /// Current velocities (m/s); used only when the model's damping is non-zero.
-    pub v: &'a [Vec3],
     /// Which particles' terms are computed, or empty: all of them. Otherwise `active_before[i]`
     /// counts the computed particles before `i` (length: particles + 1), and a particle that
     /// is not counted must be one whose terms act on nothing that is used: a fixed particle
@@ -106,7 +102,7 @@ pub struct ForceInputs<'a> {
     pub active_before: &'a [u32],
 }
 
-/// Add the elastic, hourglass and damping forces (N) of every particle to `force`.
+/// Add the elastic and hourglass forces (N) of every particle to `force`.
 ///
 /// `rotation` holds each particle's rotation, warm-started and updated in place; `pair_force`
 /// (one entry per pair slot) and `own_force` (one per particle) are scratch, used on several
@@ -568,79 +564,35 @@ fn pair_pass(
     }
     // Pass 3: force on neighbour j is -(v_i P + Q) d + c ε, on i the opposite: g_ij.
     let m = M4::splat(&(stress + qsum.sum()));
-    let damping = model.damping_stiffness * model.p_wave_modulus() * vi;
     let data = PairForceData {
         rest,
         m: &m,
         c_scale,
-        offset,
         residual,
     };
-    let fi = if damping > 0.0 {
-        let dashpot = Dashpot {
-            damping: F4::splat(damping),
-            v: input.v,
-            vel_i: V4::splat(&input.v[i]),
-        };
-        pair_forces::<true>(&data, &dashpot, pair_force)
-    } else {
-        let none = Dashpot {
-            damping: F4::splat(0.0),
-            v: &[],
-            vel_i: V4::default(),
-        };
-        pair_forces::<false>(&data, &none, pair_force)
-    };
+    let fi = pair_forces(&data, pair_force);
     fi.sum()
 }
 
 /// What pass 3 of one particle reads (see [`pair_pass`]): the rest data of its slots, `v_i P +
-/// Q` (N·m) splatted, the hourglass scale `c v_i` (N/m · m²) and the offsets `x_ij` (m) and
-/// residuals `ε_ij` (m) of passes 1 and 2.
+/// Q` (N·m) splatted, the hourglass scale `c v_i` (N/m · m²) and the residuals `ε_ij` (m) of
+/// pass 2.
 struct PairForceData<'a, 'r> {
     rest: &'a PairChunks<'r>,
     m: &'a M4,
     c_scale: F4,
-    offset: &'a [V4],
     residual: &'a [V4],
 }
 
-/// The pair dashpot of one particle: its damping coefficient `β (λ + 2μ) v_i` (N·s/m · m²,
-/// splatted), the velocities `v` (m/s) its neighbours are gathered from and its own `v_i`.
-struct Dashpot<'a> {
-    damping: F4,
-    v: &'a [Vec3],
-    vel_i: V4,
-}
-
 /// Pass 3 of one particle: the force `g_ij` (N) of each pair slot written to `pair_force`,
-/// their sum returned; with the dashpot where `DAMPED`. The two copies keep the test out of
-/// the loop, which has no free register for it.
+/// their sum returned.
 #[inline(always)]
-fn pair_forces<const DAMPED: bool>(
-    data: &PairForceData<'_, '_>,
-    dashpot: &Dashpot<'_>,
-    pair_force: &mut [[Vec3; LANES]],
-) -> V4 {
+fn pair_forces(data: &PairForceData<'_, '_>, pair_force: &mut [[Vec3; LANES]]) -> V4 {
     let rest = data.rest;
-    assert!(!DAMPED || rest.indexes_below(dashpot.v.len()));
     let mut fi = V4::default();
-    let slots = data.offset.iter().zip(data.residual).zip(pair_force);
-    for (k, ((o, eps), out)) in slots.enumerate() {
+    for (k, (eps, out)) in data.residual.iter().zip(pair_force).enumerate() {
         let c = rest.get(k);
-        let mut g = eps.scale_sub_from(c.w * data.c_scale, &data.m.mul(&c.d));
-        if DAMPED {
-            // β k_ij (v_ij · x_ij) x_ij / |x_ij|² with k_ij = (λ + 2μ) v_i |d_ij|².
-            let len2 = o.dot(o);
-            // SAFETY: checked before the loop.
-            let rate = (unsafe { rest.gather(dashpot.v, k) } - dashpot.vel_i).dot(o);
-            let k2 = c.d.dot(&c.d);
-            // Lanes of (nearly) coincident particles get no damping: their quotient (an
-            // infinity or a NaN) is computed but not selected.
-            let s = (dashpot.damping * k2 * rate) / len2;
-            let separated = F4::splat(1.0e-30).lt(len2);
-            g = o.scale_add(separated.select(s, F4::splat(0.0)), &g);
-        }
+        let g = eps.scale_sub_from(c.w * data.c_scale, &data.m.mul(&c.d));
         g.store(out);
         fi += g;
     }
@@ -736,12 +688,10 @@ mod tests {
         let volume: Vec<Real> = (0..rest.len()).map(|i| 1.0 + 0.01 * i as Real).collect();
         let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.0);
         let x = deformed(&rest);
-        let v = vec![Vec3::zeros(); x.len()];
         let input = ForceInputs {
             nbr: &nbr,
             volume: &volume,
             x: &x,
-            v: &v,
             active_before: &[],
         };
         let f = forces(&model, &input, 1);
@@ -777,12 +727,8 @@ mod tests {
         let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
         let n = rest.len();
         let volume = vec![1.0; n];
-        let damped = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
+        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.0);
         let x = deformed(&rest);
-        let v: Vec<Vec3> = x
-            .iter()
-            .map(|p| Vec3::new(0.1 * p.y, -0.2 * p.z, 0.05))
-            .collect();
         // The block's first three layers (x ≤ 2 before the jitter) fixed.
         let fixed: Vec<bool> = rest.iter().map(|p| p.x < 2.5).collect();
         let mut active_before = vec![0; n + 1];
@@ -797,7 +743,6 @@ mod tests {
             nbr: &nbr,
             volume: &volume,
             x: &x,
-            v: &v,
             active_before,
         };
         let free_forces = |f: Vec<Vec3>| -> Vec<Vec3> {
@@ -807,7 +752,7 @@ mod tests {
                 .map(|(f, _)| f)
                 .collect()
         };
-        let all = free_forces(forces(&damped, &input(&[]), 1));
+        let all = free_forces(forces(&model, &input(&[]), 1));
         for threads in 1..=3 {
             let pool = Pool::new(threads);
             let shares: Vec<_> = (0..threads)
@@ -822,7 +767,7 @@ mod tests {
                 let even = pool.share(k, active_before[n] as usize).len() as u32;
                 assert_eq!(computed, even, "share {k}");
             }
-            let skipped = forces(&damped, &input(&active_before), threads);
+            let skipped = forces(&model, &input(&active_before), threads);
             assert_eq!(all, free_forces(skipped), "{threads} threads");
         }
         // A fixed particle next to a free one, wrongly marked inert with its block.
@@ -834,57 +779,48 @@ mod tests {
         for (i, w) in wrong.iter_mut().enumerate().skip(block + 1) {
             *w = active_before[i] - (active_before[i.min(block + LANES)] - active_before[block]);
         }
-        assert_ne!(all, free_forces(forces(&damped, &input(&wrong), 1)));
+        assert_ne!(all, free_forces(forces(&model, &input(&wrong), 1)));
     }
 
     /// The gathers of the pair loops read without a check per index, after one check per
-    /// particle and field: positions or velocities that stop before a neighbour of the block
-    /// (though not before its own particles) are refused with a panic, never read past.
+    /// particle: positions that stop before a neighbour of the block (though not before its
+    /// own particles) are refused with a panic, never read past.
     #[test]
     fn fields_shorter_than_the_neighbourhoods_are_refused() {
         let rest = jittered_block();
         let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
         let n = rest.len();
         let volume = vec![1.0; n];
-        let damped = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
-        let still = vec![Vec3::zeros(); n];
-        // The first block's farthest neighbour: fields that stop just before it.
+        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.0);
+        // The first block's farthest neighbour: positions that stop just before it.
         let block = 0..LANES;
         let far = nbr.index[nbr.offsets[0] as usize..nbr.offsets[LANES] as usize]
             .iter()
             .fold(0, |m, &j| m.max(j as usize));
         assert!(far >= LANES, "a neighbour past the block's particles");
-        for (x, v) in [(&rest[..far], &still[..]), (&rest[..], &still[..far])] {
-            let input = ForceInputs {
-                nbr: &nbr,
-                volume: &volume,
-                x,
-                v,
-                active_before: &[],
-            };
-            let pass = ParticlePass {
-                model: &damped,
-                input: &input,
-                rotation_iterations: 50,
-            };
-            let run = std::panic::catch_unwind(|| {
-                let mut rotation = [Quat::identity(); LANES];
-                let mut own = [Vec3::zeros(); LANES];
-                let mut buffer = BlockBuffer::new();
-                block_pair_forces(&pass, block.start, &mut rotation, &mut buffer, &mut own);
-            });
-            assert!(
-                run.is_err(),
-                "{} positions, {} velocities",
-                x.len(),
-                v.len()
-            );
-        }
+        let input = ForceInputs {
+            nbr: &nbr,
+            volume: &volume,
+            x: &rest[..far],
+            active_before: &[],
+        };
+        let pass = ParticlePass {
+            model: &model,
+            input: &input,
+            rotation_iterations: 50,
+        };
+        let run = std::panic::catch_unwind(|| {
+            let mut rotation = [Quat::identity(); LANES];
+            let mut own = [Vec3::zeros(); LANES];
+            let mut buffer = BlockBuffer::new();
+            block_pair_forces(&pass, block.start, &mut rotation, &mut buffer, &mut own);
+        });
+        assert!(run.is_err(), "{far} positions");
     }
 
     /// The AVX-512 copy of the particle loops gives the same bits as the build's own, on one
     /// thread and on three (where pair forces are kept and summed after the barrier), with
-    /// hourglass control and damping on. On a processor without AVX-512 there is only one
+    /// hourglass control on. On a processor without AVX-512 there is only one
     /// copy: nothing to compare.
     #[test]
     fn every_kernel_gives_the_same_bits() {
@@ -896,17 +832,12 @@ mod tests {
         let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
         let n = rest.len();
         let volume: Vec<Real> = (0..n).map(|i| 1.0 + 0.01 * i as Real).collect();
-        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.01);
+        let model = ElasticModel::new(1000.0, 0.3, 0.5, 0.0);
         let x = deformed(&rest);
-        let v: Vec<Vec3> = rest
-            .iter()
-            .map(|p| Vec3::new(p.y, -p.z, 0.5 * p.x))
-            .collect();
         let input = ForceInputs {
             nbr: &nbr,
             volume: &volume,
             x: &x,
-            v: &v,
             active_before: &[],
         };
         let pass = ParticlePass {
@@ -939,49 +870,5 @@ mod tests {
                 (force.clone(), rotation.clone())
             );
         }
-    }
-
-    /// The pair dashpot: a rigid rotation's velocities give no damping force, and a
-    /// stretching velocity field gives a force that does negative work (it takes energy).
-    #[test]
-    fn pair_damping_is_zero_under_rigid_motion_and_dissipates_otherwise() {
-        let rest = jittered_block();
-        let nbr = build(&rest, SupportRadius::Automatic { target: 13 }).unwrap();
-        let volume = vec![1.0; rest.len()];
-        let damped = ElasticModel::new(1000.0, 0.3, 0.0, 0.01);
-        let spin = Vec3::new(0.2, 1.0, -0.4);
-        let rigid: Vec<Vec3> = rest.iter().map(|p| spin.cross(p) + Vec3::x()).collect();
-        let stretch: Vec<Vec3> = rest
-            .iter()
-            .map(|p| Vec3::new(p.x, 0.0, -0.5 * p.z))
-            .collect();
-        let zero = vec![Vec3::zeros(); rest.len()];
-        let at = |v: &[Vec3]| {
-            let input = ForceInputs {
-                nbr: &nbr,
-                volume: &volume,
-                x: &rest,
-                v,
-                active_before: &[],
-            };
-            forces(&damped, &input, 1)
-        };
-        let still = at(&zero);
-        let stretched = at(&stretch);
-        let scale = still
-            .iter()
-            .chain(&stretched)
-            .map(|g| g.norm())
-            .fold(1e-300, Real::max);
-        for (a, b) in at(&rigid).iter().zip(&still) {
-            assert!((a - b).norm() < 1e-12 * scale, "{a} vs {b}");
-        }
-        let power: Real = stretched
-            .iter()
-            .zip(&still)
-            .zip(&stretch)
-            .map(|((a, b), v)| (a - b).dot(v))
-            .sum();
-        assert!(power < 0.0, "damping power {power} W");
     }
 }

@@ -18,9 +18,8 @@
 //!    `V [μ |F - R|² + λ/2 tr(RᵀF - I)²]`, whose four corner forces sum to zero and whose
 //!    torque vanishes (`P Fᵀ` is symmetric).
 //!
-//! Stiffness-proportional damping with time β (s) adds
-//! `P_d = β R [2μ sym(RᵀḞ) + λ tr(RᵀḞ) I]`, `Ḟ = Σ_k v_k b_kᵀ`: the rate of the linearised
-//! corotated stress, zero under any rigid motion.
+//! Stiffness-proportional damping is not a force here: it filters the velocities after the
+//! kick, implicitly ([`crate::kernels::tet_dashpots`]).
 //!
 //! Unlike the particles' nodal integration, a tetrahedron has no zero-energy mode: no
 //! hourglass control is needed (the hourglass setting does not apply).
@@ -202,8 +201,6 @@ pub(crate) struct TetForceInputs<'a> {
     pub(crate) elements: &'a TetElements,
     /// Current positions (m).
     pub(crate) x: &'a [Vec3],
-    /// Current velocities (m/s); read only when the model's damping is non-zero.
-    pub(crate) v: &'a [Vec3],
     /// The fixed flags, or empty. A chunk of tetrahedra all of whose corners are fixed acts
     /// only on fixed particles, whose forces a step does not use: the pass skips it, which
     /// leaves the forces on fixed particles incomplete.
@@ -283,7 +280,7 @@ impl TetShares {
     }
 }
 
-/// Add every tetrahedron's elastic (and damping) forces (N) to `force`, one per particle.
+/// Add every tetrahedron's elastic forces (N) to `force`, one per particle.
 /// `shares` says where each corner force goes on several threads ([`TetShares::fit`] for these
 /// elements and this pool; unused on one thread): nothing is allocated. Unless `compressed` is empty (one entry per
 /// chunk of four tetrahedra, [`TetElements::chunk_count`]), bit `l` of chunk `c`'s entry is set
@@ -307,7 +304,7 @@ pub(crate) fn accumulate_forces(
     let elements = input.elements;
     let (m, n) = (elements.count, force.len());
     assert!(elements.corner_offsets.len() == n + 1 && input.x.len() == n);
-    assert!(input.v.len() == n && (input.fixed.is_empty() || input.fixed.len() == n));
+    assert!(input.fixed.is_empty() || input.fixed.len() == n);
     let report = !compressed.is_empty();
     assert!(!report || compressed.len() >= elements.chunks.len());
     // The chunk's bits of the tetrahedra (not its padding) below the floor.
@@ -428,16 +425,7 @@ fn chunk_forces(
     let (c0, c1, c2) = (f.column(0), f.column(1), f.column(2));
     let det = c0.dot(&c1.cross(&c2));
     let r = rotation(&f, det);
-    let mut p = corotated_stress(&f, &r, model.lambda, model.mu);
-    if model.damping_stiffness != 0.0 {
-        let rate = r.transpose().mul_mat(&gradient(input.v));
-        let mut linear = rate.add(&rate.transpose()).scale(F4::splat(model.mu));
-        let trace = F4::splat(model.lambda) * (rate.rows[0].x + rate.rows[1].y + rate.rows[2].z);
-        linear.rows[0].x += trace;
-        linear.rows[1].y += trace;
-        linear.rows[2].z += trace;
-        p = p.add(&r.mul_mat(&linear).scale(F4::splat(model.damping_stiffness)));
-    }
+    let p = corotated_stress(&f, &r, model.lambda, model.mu);
     // g_k = V P b_k: the force on corner k is -g_k, on corner 0 the sum.
     let g = dinv.rows.map(|b| p.mul(&b).scale(chunk.volume));
     let mut out = [[Vec3::zeros(); LANES]; 4];
@@ -565,14 +553,12 @@ mod tests {
         rest: &[Vec3],
         tets: &[[u32; 4]],
         x: &[Vec3],
-        v: &[Vec3],
         threads: usize,
     ) -> Vec<Vec3> {
         let elements = TetElements::new(rest, tets, &volumes(rest, tets), rest.len());
         let input = TetForceInputs {
             elements: &elements,
             x,
-            v,
             fixed: &[],
         };
         let mut shares = TetShares::default();
@@ -665,8 +651,7 @@ mod tests {
         let (rest, tets) = mesh();
         let model = ElasticModel::new(3000.0, 0.4, 0.0, 0.0);
         let x = deformed(&rest);
-        let zero = vec![Vec3::zeros(); x.len()];
-        let f = forces(&model, &rest, &tets, &x, &zero, 1);
+        let f = forces(&model, &rest, &tets, &x, 1);
         let elements = TetElements::new(&rest, &tets, &volumes(&rest, &tets), rest.len());
         let energy_at = |x: &[Vec3]| energy(&model, &elements, x);
         let h = 1e-6;
@@ -686,22 +671,16 @@ mod tests {
     }
 
     #[test]
-    fn rigid_motion_gives_no_force_and_no_damping() {
+    fn rigid_motion_gives_no_force() {
         let (rest, tets) = mesh();
-        let model = ElasticModel::new(3000.0, 0.45, 0.0, 0.01);
+        let model = ElasticModel::new(3000.0, 0.45, 0.0, 0.0);
         let rot = Quat::from_scaled_axis(Vec3::new(0.4, 2.9, -1.0));
         let x: Vec<Vec3> = rest
             .iter()
             .map(|p| rot * p + Vec3::new(0.3, -2.0, 5.0))
             .collect();
-        // The velocity of a rigid spin about an axis and a drift.
-        let w = Vec3::new(0.5, -3.0, 1.0);
-        let v: Vec<Vec3> = x
-            .iter()
-            .map(|p| w.cross(p) + Vec3::new(1.0, 2.0, 0.0))
-            .collect();
         for threads in [1, 2] {
-            let f = forces(&model, &rest, &tets, &x, &v, threads);
+            let f = forces(&model, &rest, &tets, &x, threads);
             for f in &f {
                 assert!(f.norm() < 1e-10, "{f}");
             }
@@ -711,30 +690,19 @@ mod tests {
     #[test]
     fn forces_balance_and_do_not_depend_on_the_thread_count() {
         let (rest, tets) = mesh();
-        let model = ElasticModel::new(3000.0, 0.3, 0.0, 0.02);
+        let model = ElasticModel::new(3000.0, 0.3, 0.0, 0.0);
         let x = deformed(&rest);
-        let v: Vec<Vec3> = x.iter().map(|p| Vec3::new(p.y, -p.z, 0.5 * p.x)).collect();
-        let one = forces(&model, &rest, &tets, &x, &v, 1);
+        let one = forces(&model, &rest, &tets, &x, 1);
         let sum: Vec3 = one.iter().sum();
         let scale: Real = one.iter().map(|f| f.norm()).sum();
         assert!(scale > 1.0 && sum.norm() < 1e-12 * scale, "{sum}");
-        // The damping stress is rotated by R, not by the polar part of F, so its torque is
-        // not exactly zero away from rigid motion: the torque is checked without it.
-        let elastic_only = forces(
-            &ElasticModel::new(3000.0, 0.3, 0.0, 0.0),
-            &rest,
-            &tets,
-            &x,
-            &v,
-            1,
-        );
-        let torque_elastic = elastic_only
+        let torque_elastic = one
             .iter()
             .zip(&x)
             .fold(Vec3::zeros(), |t, (f, p)| t + p.cross(f));
         assert!(torque_elastic.norm() < 1e-10 * scale, "{torque_elastic}");
         for threads in [2, 3] {
-            let many = forces(&model, &rest, &tets, &x, &v, threads);
+            let many = forces(&model, &rest, &tets, &x, threads);
             assert!(one
                 .iter()
                 .zip(&many)
@@ -753,8 +721,7 @@ mod tests {
         let mut x = rest.clone();
         let k = tet[0][3] as usize;
         x[k] = d - n * (2.0 * n.dot(&(d - a)));
-        let zero = vec![Vec3::zeros(); x.len()];
-        let f = forces(&model, &rest, &tet, &x, &zero, 1);
+        let f = forces(&model, &rest, &tet, &x, 1);
         assert!(
             crate::kernels::math::tet_volume(
                 &x[tet[0][0] as usize],

@@ -16,6 +16,7 @@ use crate::error::{check_finite, check_positive, Error};
 use crate::kernels::colouring::TetColouring;
 use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::kernels::neighbours::{self, Neighbourhoods, SupportRadius};
+use crate::kernels::tet_dashpots::TetDashpots;
 use crate::kernels::tet_elasticity::TetElements;
 use crate::mesh::TetMesh;
 use crate::model::consistency;
@@ -247,6 +248,8 @@ pub struct BodyModel {
     pub(crate) dual_cells: DualCells,
     /// The tetrahedra as corotated elements (`ElasticScheme::Tetrahedra`).
     pub(crate) tet_elements: TetElements,
+    /// The tetrahedra's edges as dashpots (`Settings::damping_stiffness` on tetrahedra).
+    pub(crate) tet_dashpots: TetDashpots,
     /// Which mesh node each particle is: every array above is in particle order.
     pub(crate) order: ParticleOrder,
 }
@@ -322,6 +325,7 @@ impl BodyModel {
         let tet_colouring = TetColouring::new(&mesh.tets, &tet_rest_volume, n);
         let dual_cells = DualCells::new(&mesh.tets, &tet_rest_volume, n);
         let tet_elements = TetElements::new(&mesh.nodes, &mesh.tets, &tet_rest_volume, n);
+        let tet_dashpots = TetDashpots::new(&mesh.nodes, &mesh.tets, &tet_rest_volume, n);
         Ok(Arc::new(BodyModel {
             options: options.clone(),
             rest: mesh.nodes.clone(),
@@ -341,6 +345,7 @@ impl BodyModel {
             tet_colouring,
             dual_cells,
             tet_elements,
+            tet_dashpots,
             order,
         }))
     }
@@ -411,6 +416,7 @@ impl BodyModel {
             + self.tet_colouring.heap_bytes()
             + self.dual_cells.heap_bytes()
             + self.tet_elements.heap_bytes()
+            + self.tet_dashpots.heap_bytes()
             + 2 * size_of_val(self.order.mesh_indices())
     }
 }

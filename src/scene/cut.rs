@@ -24,6 +24,7 @@
 use crate::kernels::colouring::TetColouring;
 use crate::kernels::math::{Mat3, Real, Vec3};
 use crate::kernels::neighbours::Neighbourhoods;
+use crate::kernels::tet_dashpots::TetDashpots;
 use crate::kernels::tet_elasticity::TetElements;
 use crate::mesh::TetMesh;
 use crate::model::body_model::BodyModel;
@@ -239,6 +240,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
     model.tet_colouring = TetColouring::new(&model.tets, &model.tet_rest_volume, n);
     model.dual_cells = DualCells::new(&model.tets, &model.tet_rest_volume, n);
     model.tet_elements = TetElements::new(&model.rest, &model.tets, &model.tet_rest_volume, n);
+    model.tet_dashpots = TetDashpots::new(&model.rest, &model.tets, &model.tet_rest_volume, n);
     let mesh = TetMesh {
         nodes: model.rest.clone(),
         tets: model.tets.clone(),

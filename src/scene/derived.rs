@@ -327,11 +327,9 @@ impl Derived {
         let n = model.particle_count();
         let mut force = vec![Vec3::zeros(); n];
         if self.from.elastic.elastic_scheme == ElasticScheme::Tetrahedra {
-            let at_rest = vec![Vec3::zeros(); positions.len()];
             let input = TetForceInputs {
                 elements: &model.tet_elements,
                 x: positions,
-                v: &at_rest,
                 fixed: &[],
             };
             // One thread needs no shares.
@@ -348,12 +346,10 @@ impl Derived {
         let mut rotation = vec![Quat::identity(); n];
         // One thread keeps no pair forces.
         let (mut pair_force, mut own_force) = (Vec::new(), Vec::new());
-        let zero = vec![Vec3::zeros(); n];
         let input = ForceInputs {
             nbr: &model.nbr,
             volume: &model.particle_volume,
             x: positions,
-            v: &zero,
             active_before: &[],
         };
         elastic::accumulate_forces(

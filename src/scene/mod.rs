@@ -192,9 +192,7 @@ impl Scene {
         for b in &self.bodies {
             let w = b.derived.omega_max;
             if w > 0.0 {
-                // Symplectic Euler with stiffness-proportional damping ξ = βω/2.
-                let xi = 0.5 * s.damping_stiffness * w;
-                h_max = h_max.min(2.0 / w * ((1.0 + xi * xi).sqrt() - xi));
+                h_max = h_max.min(2.0 / w);
             }
             radius = radius.min(b.model.particle_radius);
         }

@@ -3,6 +3,7 @@
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
+use crate::kernels::tet_dashpots::DashpotFilter;
 use crate::kernels::tet_elasticity::{self, TetForceInputs};
 use crate::scene::body::{Body, ROTATION_ITERATIONS};
 use crate::scene::settings::ElasticScheme;
@@ -47,7 +48,6 @@ pub(crate) fn predict(
                 nbr: &body.model.nbr,
                 volume: &body.model.particle_volume,
                 x: &body.state.x,
-                v: &body.state.v,
                 active_before: &body.active_before,
             };
             accumulate_forces(
@@ -66,7 +66,6 @@ pub(crate) fn predict(
             &TetForceInputs {
                 elements: &body.model.tet_elements,
                 x: &body.state.x,
-                v: &body.state.v,
                 fixed: &body.fixed,
             },
             &mut scratch.tet_shares,
@@ -75,6 +74,14 @@ pub(crate) fn predict(
             pool,
         ),
     }
+    // The stiffness-proportional damping filters the kicked velocities before the drift.
+    let elastic = &body.derived.elastic;
+    let dashpots = (elastic.damping_stiffness > 0.0).then_some(DashpotFilter {
+        mu: elastic.mu,
+        lambda: elastic.lambda,
+        beta: elastic.damping_stiffness,
+        h,
+    });
     let n = body.state.x.len();
     let state = &mut body.state;
     let (x, force, inv_mass, fixed) = (&state.x, &scratch.force, &body.inv_mass, &body.fixed);
@@ -98,6 +105,36 @@ pub(crate) fn predict(
                 *v = *v * damping_factor + force[i] * (h * inv_mass[i]);
                 *p = x[i] + *v * h;
             }
+        }
+    });
+    let Some(filter) = dashpots else {
+        return;
+    };
+    // The filtered velocities go through the predicted positions' array, then the drift anew.
+    body.model.tet_dashpots.filter(
+        &filter,
+        &state.x,
+        &state.v,
+        inv_mass,
+        &mut scratch.dashpot_load,
+        &mut scratch.p,
+        pool,
+    );
+    let (velocity, predicted) = (
+        SharedSlice::new(&mut state.v),
+        SharedSlice::new(&mut scratch.p),
+    );
+    pool.for_each_range(n, &|range| {
+        // SAFETY: the shares' ranges are disjoint.
+        let (v, p) = unsafe {
+            (
+                velocity.range(range.clone()),
+                predicted.range(range.clone()),
+            )
+        };
+        for ((i, v), p) in range.zip(v).zip(p) {
+            *v = *p;
+            *p = x[i] + *v * h;
         }
     });
 }

@@ -45,6 +45,9 @@ pub(crate) struct StepScratch {
     /// each particle of a cell's star its position relative to the cell's particle (m), its
     /// inverse mass (1/kg) and the cell volume's gradient with respect to it (m²).
     pub(crate) cell_scratch: Vec<CellSlot>,
+    /// Each particle's load on the tetrahedra's dashpot filter, `2 h β D_i / m_i`
+    /// (dimensionless; `kernels::tet_dashpots`).
+    pub(crate) dashpot_load: Vec<Real>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
 }
@@ -62,6 +65,7 @@ impl StepScratch {
             tet_shares: TetShares::default(),
             compressed: vec![0; model.tet_elements.chunk_count()],
             cell_scratch: Vec::new(),
+            dashpot_load: vec![0.0; n],
             scan: ParticleScan::EMPTY,
         };
         scratch.size_kept(model, threads);
