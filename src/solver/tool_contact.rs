@@ -27,7 +27,8 @@ use crate::solver::{StepScratch, SurfaceScratch};
 
 /// Most rounds of crush guard and contact after an iteration's contact (each only while the
 /// guard finds a tetrahedron below its floor). More rounds hold deeper presses but cost the
-/// random probing of the soak robustness (docs/VALIDATION.md §5), measured with 0 / 2 / 4 / 8:
+/// random probing of the soak robustness (docs/VALIDATION.md §5), measured with 0 / 2 / 4 / 8
+/// (before the default stiffness-proportional damping):
 /// the 24 presses of 1–10 mm probes 3 cm into the gmsh kidney meeting the contact goal 11 / 23 /
 /// – / 24; a 1 cm probe driven 20 cm into the default organ inside on 1,819 / 469 / 204 / 0
 /// steps (four sides); 80,000 soak steps with 0 / 5 / 10 / 12 rolled back, crossing surface
