@@ -22,6 +22,7 @@
 //! (`ElasticScheme::PointBased`), `--tet-volumes` one volume constraint on each tetrahedron
 //! (`VolumeScheme::Tetrahedra`), and `--paper` both: the paper's method.
 //! `--self-contact` switches the surface self-contact on (`Settings::self_contact`);
+//! `--damping S` sets the stiffness-proportional damping time β (s, `Settings::damping_stiffness`);
 //! `--profile` prints each stage's mean wall time per timed step (`World::step_profile`; the
 //! clock reads add well under a microsecond a step).
 //!
@@ -325,6 +326,7 @@ fn main() {
     let mut volume_scheme = Settings::default().volume_scheme;
     let mut elastic_scheme = Settings::default().elastic_scheme;
     let mut self_contact = false;
+    let mut damping_stiffness = Settings::default().damping_stiffness;
     let mut profile = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -349,6 +351,11 @@ fn main() {
                 volume_scheme = VolumeScheme::Tetrahedra;
             }
             "--self-contact" => self_contact = true,
+            "--damping" => {
+                damping_stiffness = (args.next().expect("--damping SECONDS"))
+                    .parse()
+                    .expect("a number of seconds")
+            }
             "--profile" => profile = true,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
@@ -385,6 +392,7 @@ fn main() {
                     volume_scheme,
                     elastic_scheme,
                     self_contact,
+                    damping_stiffness,
                     ..Settings::default()
                 },
             );

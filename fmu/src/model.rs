@@ -190,7 +190,7 @@ crate::fmi2_variables! {
         NEEDLE_DEPTH = output("needle_depth", "m", "How far the needle's tip is past its entry point along the shaft at the end of the step (0 before puncture, after withdrawal, or when the tool is not a needle)"),
         ELASTIC_SCHEME = Variable::enumeration("elastic_scheme", Parameter, Fixed, &ELASTIC_SCHEME_TYPE, 0, "Elasticity: 0 corotated tetrahedra (the default), 1 the paper's point-based particles"),
         VOLUME_SCHEME = Variable::enumeration("volume_scheme", Parameter, Fixed, &VOLUME_SCHEME_TYPE, 0, "Volume constraints: 0 one per particle's dual cell (the default), 1 one per tetrahedron (the paper's)"),
-        DAMPING_STIFFNESS = param("damping_stiffness", Tunable, "s", 3e-4, Some(0.0), "Stiffness-proportional damping time beta: dashpots on the tetrahedra's edges, filtered implicitly (no substeps added); with the paper's particles, explicit pair dashpots that can add substeps"),
+        DAMPING_STIFFNESS = param("damping_stiffness", Tunable, "s", 0.0, Some(0.0), "Stiffness-proportional damping time beta: dashpots on the tetrahedra's edges, filtered implicitly (no substeps added); with the paper's particles, explicit pair dashpots that can add substeps"),
         MIN_SUBSTEPS = Variable::integer("min_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps per internal step (more where the stability limit or a fast tool needs them)"),
     ];
 }

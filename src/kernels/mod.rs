@@ -10,6 +10,7 @@
 //!   [`point_elasticity`] (the force pass), [`stability`] (the explicit stability limit);
 //! - [`tet_elasticity`]: corotated linear tetrahedra, the other force kernel, and [`incidence`]
 //!   (the tetrahedra around each node, for it and the dual cells);
+//! - [`tet_dashpots`]: stiffness-proportional damping on the mesh edges, implicit;
 //! - [`constraints`]: the XPBD/PBD projections (volume, contact, friction);
 //! - [`collision`]: broad phases and geometric queries.
 

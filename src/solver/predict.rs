@@ -1,5 +1,6 @@
 //! Forces and the symplectic prediction of a body for one substep.
 
+use crate::kernels::lanes::LANES;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
@@ -74,9 +75,12 @@ pub(crate) fn predict(
             pool,
         ),
     }
-    // The stiffness-proportional damping filters the kicked velocities before the drift.
+    // The stiffness-proportional damping filters the kicked velocities before the drift
+    // (`kernels::tet_dashpots`): the particles' loads with the kick, the edges' impulses, then
+    // each particle's sum of them with the drift.
     let elastic = &body.derived.elastic;
-    let dashpots = (elastic.damping_stiffness > 0.0).then_some(DashpotFilter {
+    let dashpots = &body.model.tet_dashpots;
+    let filter = (elastic.damping_stiffness > 0.0).then_some(DashpotFilter {
         mu: elastic.mu,
         lambda: elastic.lambda,
         beta: elastic.damping_stiffness,
@@ -85,19 +89,21 @@ pub(crate) fn predict(
     let n = body.state.x.len();
     let state = &mut body.state;
     let (x, force, inv_mass, fixed) = (&state.x, &scratch.force, &body.inv_mass, &body.fixed);
-    let (velocity, predicted) = (
+    let (velocity, predicted, loads) = (
         SharedSlice::new(&mut state.v),
         SharedSlice::new(&mut scratch.p),
+        SharedSlice::new(&mut scratch.dashpot_load),
     );
     pool.for_each_range(n, &|range| {
         // SAFETY: the shares' ranges are disjoint.
-        let (v, p) = unsafe {
+        let (v, p, load) = unsafe {
             (
                 velocity.range(range.clone()),
                 predicted.range(range.clone()),
+                loads.range(range.clone()),
             )
         };
-        for ((i, v), p) in range.zip(v).zip(p) {
+        for (((i, v), p), load) in range.zip(v).zip(p).zip(load) {
             if fixed[i] {
                 *v = Vec3::zeros();
                 *p = x[i];
@@ -105,21 +111,32 @@ pub(crate) fn predict(
                 *v = *v * damping_factor + force[i] * (h * inv_mass[i]);
                 *p = x[i] + *v * h;
             }
+            if let Some(filter) = &filter {
+                *load = filter.load(dashpots, i, inv_mass[i]);
+            }
         }
     });
-    let Some(filter) = dashpots else {
+    let Some(filter) = filter else {
         return;
     };
-    // The filtered velocities go through the predicted positions' array, then the drift anew.
-    body.model.tet_dashpots.filter(
-        &filter,
-        &state.x,
-        &state.v,
-        inv_mass,
-        &mut scratch.dashpot_load,
-        &mut scratch.p,
-        pool,
-    );
+    // The corners of the tetrahedra the force pass found crushed get no damping.
+    let undamped = &mut scratch.dashpot_undamped;
+    undamped.fill(false);
+    if scheme == ElasticScheme::Tetrahedra {
+        let elements = &body.model.tet_elements;
+        let chunks = elements.chunk_count();
+        for (c, &bits) in scratch.compressed[..chunks].iter().enumerate() {
+            for l in (0..LANES).filter(|l| bits & 1 << l != 0) {
+                for k in elements.corners(elements.tet_at(LANES * c + l)) {
+                    undamped[k as usize] = true;
+                }
+            }
+        }
+    }
+    let impulse = &mut scratch.dashpot_impulse[..dashpots.slot_count()];
+    let (load, undamped) = (&scratch.dashpot_load, &scratch.dashpot_undamped);
+    dashpots.edge_impulses(&filter, x, &state.v, load, undamped, impulse, pool);
+    let impulse = &*impulse;
     let (velocity, predicted) = (
         SharedSlice::new(&mut state.v),
         SharedSlice::new(&mut scratch.p),
@@ -133,8 +150,10 @@ pub(crate) fn predict(
             )
         };
         for ((i, v), p) in range.zip(v).zip(p) {
-            *v = *p;
-            *p = x[i] + *v * h;
+            if !fixed[i] {
+                *v += dashpots.impulse_on(i, impulse) * inv_mass[i];
+                *p = x[i] + *v * h;
+            }
         }
     });
 }

@@ -45,9 +45,14 @@ pub(crate) struct StepScratch {
     /// each particle of a cell's star its position relative to the cell's particle (m), its
     /// inverse mass (1/kg) and the cell volume's gradient with respect to it (m²).
     pub(crate) cell_scratch: Vec<CellSlot>,
-    /// Each particle's load on the tetrahedra's dashpot filter, `2 h β D_i / m_i`
-    /// (dimensionless; `kernels::tet_dashpots`).
+    /// Each particle's load on the damping filter, `2 h β D_i / m_i` (dimensionless), and the
+    /// edges' impulses on their particles (N·s), in the load-time mesh's slots (a cut body uses
+    /// the first ones) (`kernels::tet_dashpots`).
     pub(crate) dashpot_load: Vec<Real>,
+    pub(crate) dashpot_impulse: Vec<Vec3>,
+    /// The particles the damping filter leaves alone in a substep: the corners of the
+    /// tetrahedra the force pass found crushed.
+    pub(crate) dashpot_undamped: Vec<bool>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
 }
@@ -66,6 +71,8 @@ impl StepScratch {
             compressed: vec![0; model.tet_elements.chunk_count()],
             cell_scratch: Vec::new(),
             dashpot_load: vec![0.0; n],
+            dashpot_undamped: vec![false; n],
+            dashpot_impulse: vec![Vec3::zeros(); model.tet_dashpots.slot_count()],
             scan: ParticleScan::EMPTY,
         };
         scratch.size_kept(model, threads);
