@@ -171,6 +171,19 @@ impl TetElements {
         self.chunks.len()
     }
 
+    /// The model's tetrahedra that the force pass's `compressed` bits (one byte a chunk, the
+    /// first [`TetElements::chunk_count`] read) list, in the order of the chunks.
+    pub(crate) fn compressed<'a>(
+        &'a self,
+        compressed: &'a [u8],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let chunks = compressed[..self.chunk_count()].iter().enumerate();
+        chunks.flat_map(move |(c, &bits)| {
+            let lanes = (0..LANES).filter(move |l| bits & 1 << l != 0);
+            lanes.map(move |l| self.tet_at(LANES * c + l))
+        })
+    }
+
     /// The deformation gradient (dimensionless) of tetrahedron `t` at positions `x` (m).
     pub(crate) fn deformation_gradient(&self, t: usize, x: &[Vec3]) -> Mat3 {
         let (tet, dinv) = self.element(t);

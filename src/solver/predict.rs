@@ -1,6 +1,5 @@
 //! Forces and the symplectic prediction of a body for one substep.
 
-use crate::kernels::lanes::LANES;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::kernels::point_elasticity::{accumulate_forces, ForceInputs};
@@ -124,12 +123,9 @@ pub(crate) fn predict(
     undamped.fill(false);
     if scheme == ElasticScheme::Tetrahedra {
         let elements = &body.model.tet_elements;
-        let chunks = elements.chunk_count();
-        for (c, &bits) in scratch.compressed[..chunks].iter().enumerate() {
-            for l in (0..LANES).filter(|l| bits & 1 << l != 0) {
-                for k in elements.corners(elements.tet_at(LANES * c + l)) {
-                    undamped[k as usize] = true;
-                }
+        for t in elements.compressed(&scratch.compressed) {
+            for k in elements.corners(t) {
+                undamped[k as usize] = true;
             }
         }
     }

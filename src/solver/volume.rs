@@ -226,25 +226,21 @@ pub(crate) fn project_crushed_tets(body: &Body, scratch: &mut StepScratch) -> bo
     let mut lifted = false;
     let elements = &body.model.tet_elements;
     let p = &mut scratch.p;
-    let chunks = elements.chunk_count();
-    for (c, &bits) in scratch.compressed[..chunks].iter().enumerate() {
-        for l in (0..LANES).filter(|l| bits & 1 << l != 0) {
-            let t = elements.tet_at(LANES * c + l);
-            let corners = elements.corners(t).map(|k| k as usize);
-            let x = corners.map(|k| p[k]);
-            let w = corners.map(|k| body.inv_mass[k]);
-            let floor = CRUSH_FLOOR_RATIO * elements.volume(t);
-            let mut lambda = 0.0;
-            // The hard constraint `V = floor`, applied only below it.
-            if crate::kernels::math::tet_volume(&x[0], &x[1], &x[2], &x[3]) >= floor {
-                continue;
+    for t in elements.compressed(&scratch.compressed) {
+        let corners = elements.corners(t).map(|k| k as usize);
+        let x = corners.map(|k| p[k]);
+        let w = corners.map(|k| body.inv_mass[k]);
+        let floor = CRUSH_FLOOR_RATIO * elements.volume(t);
+        let mut lambda = 0.0;
+        // The hard constraint `V = floor`, applied only below it.
+        if crate::kernels::math::tet_volume(&x[0], &x[1], &x[2], &x[3]) >= floor {
+            continue;
+        }
+        if let Some(dp) = volume_tet_correction(x, w, floor, 0.0, &mut lambda) {
+            for (k, d) in corners.iter().zip(dp) {
+                p[*k] += d;
             }
-            if let Some(dp) = volume_tet_correction(x, w, floor, 0.0, &mut lambda) {
-                for (k, d) in corners.iter().zip(dp) {
-                    p[*k] += d;
-                }
-                lifted = true;
-            }
+            lifted = true;
         }
     }
     lifted
