@@ -248,7 +248,7 @@ pub struct BodyModel {
     pub(crate) dual_cells: DualCells,
     /// The tetrahedra as corotated elements (`ElasticScheme::Tetrahedra`).
     pub(crate) tet_elements: TetElements,
-    /// The tetrahedra's edges as dashpots (`Settings::damping_stiffness` on tetrahedra).
+    /// The tetrahedra's edges as dashpots (`Settings::damping_stiffness`, both elastic schemes).
     pub(crate) tet_dashpots: TetDashpots,
     /// Which mesh node each particle is: every array above is in particle order.
     pub(crate) order: ParticleOrder,

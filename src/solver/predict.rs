@@ -106,12 +106,14 @@ pub(crate) fn predict(
             if fixed[i] {
                 *v = Vec3::zeros();
                 *p = x[i];
+                *load = 0.0;
             } else {
                 *v = *v * damping_factor + force[i] * (h * inv_mass[i]);
-                *p = x[i] + *v * h;
-            }
-            if let Some(filter) = &filter {
-                *load = filter.load(dashpots, i, inv_mass[i]);
+                match &filter {
+                    // The drift waits for the filtered velocity.
+                    Some(filter) => *load = filter.load(dashpots, i, inv_mass[i]),
+                    None => *p = x[i] + *v * h,
+                }
             }
         }
     });
