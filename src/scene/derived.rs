@@ -160,12 +160,21 @@ impl Derived {
         derived
     }
 
-    /// Re-derive under `from`: nothing when it is what the data were derived under; the
-    /// elastic level when that changed (the physical estimate only if the elastic constants or
+    /// Re-derive under `from`: nothing when it is what the data were derived under; only the
+    /// damping time when nothing else changed; the elastic level when that changed (the physical estimate only if the elastic constants or
     /// the scheme changed), then the mass scaling. Returns whether the inertial masses were
     /// recomputed (the caller's inverse masses follow them).
     pub(crate) fn rederive(&mut self, model: &BodyModel, from: DerivedFrom) -> bool {
         if from == self.from {
+            return false;
+        }
+        // The stiffness-proportional damping filters velocities only: neither the stability
+        // estimate nor the inertial masses depend on it.
+        let mut damped = self.from;
+        damped.elastic.damping_stiffness = from.elastic.damping_stiffness;
+        if from == damped {
+            self.from = from;
+            self.elastic.damping_stiffness = from.elastic.damping_stiffness;
             return false;
         }
         if from.elastic != self.from.elastic {
