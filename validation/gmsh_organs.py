@@ -9,7 +9,10 @@
                duplicate vertices merged, the surface reparametrised by gmsh (classifySurfaces/createGeometry),
                remeshed and volume-meshed by gmsh.  Licence: LGPL-2.1 (derived from SOFA's file).
 
-Usage:  build/venv-validation/bin/python validation/gmsh_organs.py [kidney_gmsh] [liver_gmsh] [--out data/meshes]
+  *_coarse, *_fine  each organ at element size x sqrt(2) and / sqrt(2): the refinement families of the
+               convergence study.
+
+Usage:  build/venv-validation/bin/python validation/gmsh_organs.py [kidney_gmsh] [liver_gmsh] [...] [--out data/meshes]
 The meshes are deterministic for a given gmsh version (4.15.2); data/meshes/README.md lists their SHA-256.
 """
 import argparse
@@ -164,7 +167,11 @@ def liver(size, angle_deg=60.0):
 
 
 LIVER_SURFACE = 'liver_31k'  # 'obj' = liver-smooth.obj itself: self-intersecting, gmsh's 3-D mesher refuses it
-BUILDERS = dict(kidney_gmsh=(kidney, 0.22), liver_gmsh=(liver, 0.28))
+# The two organs, and each at a coarser and a finer size (element size x sqrt(2) and / sqrt(2)): the
+# refinement families of the convergence study (docs/VALIDATION.md, validation/README.md g).
+BUILDERS = dict(kidney_gmsh=(kidney, 0.22), liver_gmsh=(liver, 0.28),
+                kidney_gmsh_coarse=(kidney, 0.31), kidney_gmsh_fine=(kidney, 0.155),
+                liver_gmsh_coarse=(liver, 0.4), liver_gmsh_fine=(liver, 0.2))
 
 
 def main():
