@@ -22,7 +22,8 @@
 //! energy audit of `audit.rs`: the deviatoric energy of the P2 field as the particles see it,
 //! over what linear tetrahedra see, for the surface, interior and fixed particles.
 //! Scenes: `liver_1k6`, `liver_4k`, `liver_10k`, `organ_c0133`, `organ_c0095`, `organ_c0068`,
-//! `kidney_gmsh`, `liver_gmsh` (at each ν of `--nu`, default 0.3 and 0.45), `cantilever`
+//! `kidney_gmsh`, `liver_gmsh` and their refinements `*_coarse`, `*_fine` (at each ν of `--nu`,
+//! default 0.3 and 0.45), `cantilever`
 //! (ν 0.3, and 0.45 when its reference exists).
 //! A scene whose reference file is missing is reported and skipped.
 
@@ -127,7 +128,7 @@ fn scenes(names: &[String], ratios: &[Real]) -> Res<Vec<Scene>> {
                     "cantilever_nu045".to_string()
                 };
                 (m, prefix)
-            } else if name.ends_with("_gmsh") {
+            } else if name.contains("_gmsh") {
                 let m = mesh::load(&mesh_dir().join(format!("{name}.node")), 1.0)?.0;
                 (m, format!("{name}_{tag}"))
             } else {
