@@ -78,14 +78,25 @@ fn hanging_mesh(name: &str) -> (TetMesh, Vec<u32>, Vec<usize>) {
     (mesh, fixed, ids)
 }
 
-/// A TetGen liver in mesh units, E 3000, ρ 1, g 0.981, top 10% fixed, at ν 0.3 or 0.45.
-fn liver_error(name: &str, nu: Real, settings: Settings, options: BodyOptions) -> Real {
-    let (mesh, fixed, ids) = hanging_mesh(name);
-    let material = Material {
+/// The sag scenes' material at Poisson's ratio `nu`: E 3000, ρ 1 (mesh units).
+fn sag_material(nu: Real) -> Material {
+    Material {
         youngs_modulus: 3000.0,
         poisson_ratio: nu,
         density: 1.0,
-    };
+    }
+}
+
+/// The references' file tag of `nu`: `nu030`, `nu045`, `nu049`, `nu0499`.
+fn nu_tag(nu: Real) -> String {
+    let digits = format!("{nu}");
+    format!("nu0{:0<2}", digits.trim_start_matches("0."))
+}
+
+/// A TetGen liver in mesh units, E 3000, ρ 1, g 0.981, top 10% fixed, at ν 0.3 or 0.45.
+fn liver_error(name: &str, nu: Real, settings: Settings, options: BodyOptions) -> Real {
+    let (mesh, fixed, ids) = hanging_mesh(name);
+    let material = sag_material(nu);
     // Displacement-only P2 at ν 0.3, mixed Taylor–Hood at 0.45 (P2 locks a few per cent there).
     let file = if nu == 0.3 { "nu030_p2" } else { "nu045_th" };
     let file = format!("{}_{file}.csv", name.replace('_', ""));
@@ -230,18 +241,13 @@ fn against_taylor_hood_on_meshes_from_another_mesher() {
     ] {
         let (mesh, fixed, ids) = hanging_mesh(name);
         for (nu, measured, measured_paper) in cases {
-            let tag = format!("nu0{}", format!("{nu}").trim_start_matches("0."));
-            let tag = if nu == 0.3 { "nu030".to_string() } else { tag };
+            let tag = nu_tag(nu);
             let kind = if nu == 0.3 { "p2" } else { "th" };
             let (reference, p1) = (
                 format!("{name}_{tag}_{kind}.csv"),
                 format!("{name}_{tag}_p1.csv"),
             );
-            let material = Material {
-                youngs_modulus: 3000.0,
-                poisson_ratio: nu,
-                density: 1.0,
-            };
+            let material = sag_material(nu);
             let run = |settings: Settings| {
                 let d = (settings, BodyOptions::default());
                 sag_error(&mesh, &fixed, &ids, material, 0.981, d, &reference)
@@ -331,12 +337,8 @@ fn error_falls_with_refinement_on_two_organs() {
         ];
         let meshes: Vec<_> = levels.iter().map(|name| hanging_mesh(name)).collect();
         for (nu, measured) in measured {
-            let tag = format!("nu0{}", format!("{nu}").trim_start_matches("0."));
-            let material = Material {
-                youngs_modulus: 3000.0,
-                poisson_ratio: nu,
-                density: 1.0,
-            };
+            let tag = nu_tag(nu);
+            let material = sag_material(nu);
             let mut errors = Vec::new();
             let mut p1_errors = Vec::new();
             for ((name, (mesh, fixed, ids)), measured) in levels.iter().zip(&meshes).zip(measured) {
