@@ -6,7 +6,7 @@
 //!                             [--steps N]
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
 //!                             [--times PATH] [--particles] [--tet-volumes] [--paper]
-//!                             [--self-contact] [--profile]
+//!                             [--self-contact] [--damping S] [--crushed-substeps N] [--profile]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -23,6 +23,8 @@
 //! (`VolumeScheme::Tetrahedra`), and `--paper` both: the paper's method.
 //! `--self-contact` switches the surface self-contact on (`Settings::self_contact`);
 //! `--damping S` sets the stiffness-proportional damping time β (s, `Settings::damping_stiffness`);
+//! `--crushed-substeps N` the substeps of a step that starts with a crushed tetrahedron
+//! (`Settings::crushed_substeps`);
 //! `--profile` prints each stage's mean wall time per timed step (`World::step_profile`; the
 //! clock reads add well under a microsecond a step).
 //!
@@ -327,6 +329,7 @@ fn main() {
     let mut elastic_scheme = Settings::default().elastic_scheme;
     let mut self_contact = false;
     let mut damping_stiffness = Settings::default().damping_stiffness;
+    let mut crushed_substeps = Settings::default().crushed_substeps;
     let mut profile = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -355,6 +358,11 @@ fn main() {
                 damping_stiffness = (args.next().expect("--damping SECONDS"))
                     .parse()
                     .expect("a number of seconds")
+            }
+            "--crushed-substeps" => {
+                crushed_substeps = (args.next().expect("--crushed-substeps N"))
+                    .parse()
+                    .expect("a number of substeps")
             }
             "--profile" => profile = true,
             "--bench" => {}
@@ -393,6 +401,7 @@ fn main() {
                     elastic_scheme,
                     self_contact,
                     damping_stiffness,
+                    crushed_substeps,
                     ..Settings::default()
                 },
             );

@@ -154,6 +154,10 @@ pub struct Settings {
     pub gravity: [Real; 3],
     /// Smallest number of substeps per step (>= 1). Default 1.
     pub min_substeps: u32,
+    /// Smallest number of substeps of a step that starts with the tissue at a tool compressed
+    /// (a tetrahedron touching it below half its rest volume). Default 1 (none added); 2 for
+    /// deep presses.
+    pub crushed_substeps: u32,
     /// Largest number of substeps per step; a step needing more is clamped. Default 64.
     pub max_substeps: u32,
     /// Fraction (0, 1] of the explicit stability limit 2/omega_max a substep may use. Default 0.9.
@@ -199,6 +203,7 @@ impl Settings {
             dt: self.dt,
             gravity: Vec3::new(g[0], g[1], g[2]),
             min_substeps: self.min_substeps,
+            crushed_substeps: self.crushed_substeps,
             max_substeps: self.max_substeps,
             stability_margin: self.stability_margin,
             mass_scaling: self.mass_scaling,
@@ -224,6 +229,7 @@ impl Settings {
             dt: s.dt,
             gravity: [s.gravity.x, s.gravity.y, s.gravity.z],
             min_substeps: s.min_substeps,
+            crushed_substeps: s.crushed_substeps,
             max_substeps: s.max_substeps,
             stability_margin: s.stability_margin,
             mass_scaling: s.mass_scaling,
@@ -260,6 +266,7 @@ impl Settings {
                 dt,
                 gravity,
                 min_substeps,
+                crushed_substeps,
                 max_substeps,
                 stability_margin,
                 mass_scaling,
@@ -295,6 +302,7 @@ impl Settings {
                 dt,
                 gravity,
                 min_substeps,
+                crushed_substeps,
                 max_substeps,
                 stability_margin,
                 mass_scaling,

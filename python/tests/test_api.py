@@ -140,10 +140,10 @@ def shape_bottom(shape: ts.ToolShape) -> float:
 
 def test_settings_mirror_every_rust_field():
     fields = [
-        "dt", "gravity", "min_substeps", "max_substeps", "stability_margin", "mass_scaling",
-        "damping_mass", "damping_stiffness", "hourglass_stiffness", "volume_constraints",
-        "volumetric_split", "volume_scheme", "elastic_scheme", "volume_compliance", "iterations",
-        "contact_mode",
+        "dt", "gravity", "min_substeps", "crushed_substeps", "max_substeps", "stability_margin",
+        "mass_scaling", "damping_mass", "damping_stiffness", "hourglass_stiffness",
+        "volume_constraints", "volumetric_split", "volume_scheme", "elastic_scheme",
+        "volume_compliance", "iterations", "contact_mode",
         "max_depenetration_speed", "self_contact", "threads", "divergence",
     ]  # fmt: skip
     s = ts.Settings()

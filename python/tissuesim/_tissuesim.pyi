@@ -121,6 +121,10 @@ class Settings:
     """Gravity acceleration (m/s²), 3 values. Default [0, -9.81, 0]."""
     min_substeps: int
     """Smallest number of substeps per step (≥ 1). Default 1."""
+    crushed_substeps: int
+    """Smallest number of substeps of a step that starts with the tissue at a tool compressed (a
+    tetrahedron touching it below half its rest volume, now or two steps ahead). Default 1 (none
+    added); 2 for deep presses (docs/SETTINGS.md)."""
     max_substeps: int
     """Largest number of substeps per step (a step needing more is clamped). Default 64."""
     stability_margin: float

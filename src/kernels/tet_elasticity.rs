@@ -31,7 +31,7 @@
 //! particle's force is so summed in the elements' order: the same bits on any number of threads.
 
 use crate::kernels::lanes::{F4, LANES, M4, V4};
-use crate::kernels::math::{Mat3, Quat, Real, Vec3};
+use crate::kernels::math::{tet_volume, Mat3, Quat, Real, Vec3};
 use crate::kernels::parallel::{share_of, Barrier, Pool, SharedSlice};
 use crate::kernels::point_elasticity::{corotated_stress, ElasticModel};
 use crate::kernels::rotation::{extract_rotations, rotation_from_svd};
@@ -182,6 +182,28 @@ impl TetElements {
             let lanes = (0..LANES).filter(move |l| bits & 1 << l != 0);
             lanes.map(move |l| self.tet_at(LANES * c + l))
         })
+    }
+
+    /// Whether a tetrahedron with corner `i` is below `ratio` (dimensionless) of its rest volume
+    /// at positions `x` (m), or will be after `time` (s) at velocities `v` (m/s).
+    pub(crate) fn compressed_around(
+        &self,
+        i: usize,
+        (x, v): (&[Vec3], &[Vec3]),
+        time: Real,
+        ratio: Real,
+    ) -> bool {
+        let (start, end) = (self.corner_offsets[i], self.corner_offsets[i + 1]);
+        self.corners[start as usize..end as usize]
+            .iter()
+            .any(|&slot| {
+                let e = slot as usize / 4;
+                let chunk = &self.chunks[e / LANES];
+                let corners = chunk.tets[e % LANES].map(|k| k as usize);
+                let floor = ratio * chunk.volume.to_array()[e % LANES];
+                let below = |[a, b, c, d]: [Vec3; 4]| tet_volume(&a, &b, &c, &d) < floor;
+                below(corners.map(|k| x[k])) || below(corners.map(|k| x[k] + v[k] * time))
+            })
     }
 
     /// The deformation gradient (dimensionless) of tetrahedron `t` at positions `x` (m).

@@ -69,6 +69,16 @@ pub struct Settings {
     /// Smallest number of substeps per step (≥ 1). The world adds substeps when the explicit
     /// elastic step would be unstable (see [`Settings::stability_margin`]).
     pub min_substeps: u32,
+    /// Smallest number of substeps (≥ 1) of a step that starts with the tissue at a tool
+    /// compressed: a tetrahedron with a corner within a particle radius of a tool below half
+    /// its rest volume, now or two steps ahead at its corners' velocities. Applies with the
+    /// elasticity on tetrahedra and the volume constraints on (where the crush guard runs).
+    /// 1 (the default) adds none. 2 keeps small probes pressed deep out of the tissue (a 1 mm
+    /// sphere 3 cm into organs of another mesher, a 1 cm probe 20 cm into the default organ)
+    /// at twice the cost of the steps that compress it, which in a deep press is most of them
+    /// (docs/SETTINGS.md, "Deep presses"). The check costs a distance per particle when the
+    /// setting is above 1 and a tool is in the world.
+    pub crushed_substeps: u32,
     /// Largest number of substeps per step; a step that needs more is reported
     /// (`StepReport::substeps_clamped`) and runs with this many.
     pub max_substeps: u32,
@@ -202,6 +212,7 @@ impl Default for Settings {
             dt: 1.0e-3,
             gravity: Vec3::new(0.0, -9.81, 0.0),
             min_substeps: 1,
+            crushed_substeps: 1,
             max_substeps: 64,
             stability_margin: 0.9,
             mass_scaling: true,
@@ -253,6 +264,9 @@ impl Settings {
         check_positive("settings.dt", self.dt, "s")?;
         if self.min_substeps == 0 || self.max_substeps < self.min_substeps {
             return bad("min_substeps/max_substeps: need 1 <= min_substeps <= max_substeps");
+        }
+        if self.crushed_substeps == 0 || self.max_substeps < self.crushed_substeps {
+            return bad("crushed_substeps: need 1 <= crushed_substeps <= max_substeps");
         }
         if !(self.stability_margin > 0.0 && self.stability_margin <= 1.0) {
             return bad("stability_margin must be in (0, 1]");

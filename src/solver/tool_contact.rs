@@ -19,7 +19,7 @@ use crate::interaction::{sampled_contact, surface_contact};
 use crate::kernels::math::Real;
 use crate::kernels::parallel::Pool;
 use crate::scene::body::Body;
-use crate::scene::settings::{ContactMode, ElasticScheme};
+use crate::scene::settings::ContactMode;
 use crate::scene::tool::Pose;
 use crate::scene::{Scene, ToolSlot};
 use crate::solver::volume;
@@ -98,10 +98,7 @@ pub(crate) fn project_tool_contacts(
         }
     };
     contact(surface, scene, scratch, count, false);
-    let guarded = scene.settings.volume_constraints
-        && scene.settings.elastic_scheme == ElasticScheme::Tetrahedra
-        && scene.tools.iter().flatten().any(|s| !s.blade);
-    if !guarded {
+    if !scene.crush_guard_on() {
         return;
     }
     for _ in 0..CRUSH_CONTACT_ROUNDS {

@@ -1,0 +1,109 @@
+//! `Settings::crushed_substeps`: a step that starts with a tetrahedron touching a tool
+//! compressed below half its rest volume takes at least that many substeps; otherwise the step
+//! substeps as before. The rule reads the state at the start of the step only (positions, the
+//! tools' poses), so a restored state steps the same.
+
+mod common;
+
+use tissuesim::{
+    mesh, BodyId, BodyOptions, Error, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+};
+
+/// The radius (m) of the probe resting on the box.
+const PROBE: Real = 0.005;
+
+/// A weightless 6 cm lattice box flattened along y to `fraction` of its height about its
+/// bottom (every tetrahedron at `fraction` of its rest volume), at rest, under `settings`.
+fn flattened_box(settings: Settings, fraction: Real) -> (World, BodyId) {
+    let mut world = World::new(settings).unwrap();
+    let size = 0.06;
+    let box_mesh = mesh::lattice_box(Vec3::zeros(), Vec3::repeat(size), [6, 6, 6]);
+    let body = world.add_body(&box_mesh, &BodyOptions::default()).unwrap();
+    let b = world.body(body).unwrap();
+    let x: Vec<Vec3> = (b.rest_positions().iter())
+        .map(|p| Vec3::new(p.x, p.y * fraction, p.z))
+        .collect();
+    let v = vec![Vec3::zeros(); x.len()];
+    world.set_body_state(body, &x, &v).unwrap();
+    (world, body)
+}
+
+/// A sphere of [`PROBE`] radius resting on the flattened top face of a box of 6 cm flattened to
+/// `fraction`, or `away` from it (m, upwards).
+fn probe_on_top(world: &mut World, fraction: Real, away: Real) {
+    let top = 0.06 * fraction;
+    let centre = Vec3::new(0.03, top + PROBE + away, 0.03);
+    let sphere = ToolShape::Sphere { radius: PROBE };
+    world
+        .add_tool(sphere, Pose::at(centre), &ToolOptions::default())
+        .unwrap();
+}
+
+fn crushed(substeps: u32) -> Settings {
+    Settings {
+        crushed_substeps: substeps,
+        ..common::weightless()
+    }
+}
+
+#[test]
+fn a_tool_on_tissue_below_half_its_volume_takes_the_crushed_substeps() {
+    let (mut world, _) = flattened_box(crushed(2), 0.4);
+    assert_eq!(
+        world.substeps_needed(),
+        (1, false),
+        "no tool: no extra substep"
+    );
+    probe_on_top(&mut world, 0.4, 0.0);
+    assert_eq!(world.substeps_needed(), (2, false));
+    let report = world.step().unwrap();
+    assert_eq!(report.substeps, 2);
+}
+
+/// The substeps the next step of [`flattened_box`] with a probe [`probe_on_top`] needs.
+fn substeps_with_probe(settings: Settings, fraction: Real, away: Real) -> (u32, bool) {
+    let (mut world, _) = flattened_box(settings, fraction);
+    probe_on_top(&mut world, fraction, away);
+    world.substeps_needed()
+}
+
+#[test]
+fn tissue_above_half_its_volume_or_far_from_the_tool_takes_one_substep() {
+    let one = (1, false);
+    assert_eq!(
+        substeps_with_probe(crushed(2), 0.6, 0.0),
+        one,
+        "compressed to 0.6 only"
+    );
+    assert_eq!(
+        substeps_with_probe(crushed(2), 0.4, 0.02),
+        one,
+        "the probe 2 cm above"
+    );
+    assert_eq!(
+        substeps_with_probe(crushed(1), 0.4, 0.0),
+        one,
+        "the default adds none"
+    );
+    let paper = common::paper(crushed(2));
+    assert_eq!(
+        substeps_with_probe(paper, 0.4, 0.0),
+        one,
+        "the paper's particles have no crush guard"
+    );
+}
+
+#[test]
+fn crushed_substeps_outside_one_to_max_substeps_are_refused() {
+    for (substeps, max_substeps) in [(0, 64), (9, 8)] {
+        let settings = Settings {
+            crushed_substeps: substeps,
+            max_substeps,
+            ..Settings::default()
+        };
+        match World::new(settings).err() {
+            Some(Error::InvalidArgument(m)) => assert!(m.contains("crushed_substeps"), "{m}"),
+            other => panic!("crushed_substeps {substeps} of {max_substeps}: {other:?}"),
+        }
+    }
+}
