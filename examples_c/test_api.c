@@ -194,6 +194,29 @@ static void test_schemes(double h) {
     CHECK(memcmp(a, b, sizeof a) != 0);
 }
 
+/* The crushed-step substeps: 1 until set, kept by ts_world_set_settings, 0 or more than
+ * max_substeps refused with nothing changed. */
+static void test_crushed_substeps(void) {
+    ts_settings settings;
+    ts_world *world = NULL;
+    uint32_t n = 0;
+    CHECK_OK(ts_settings_default(&settings));
+    CHECK_OK(ts_world_new(&settings, &world));
+    CHECK_ST(ts_world_crushed_substeps(world, NULL), TS_STATUS_NULL_PARAMETER);
+    CHECK_ST(ts_world_set_crushed_substeps(NULL, 2), TS_STATUS_NULL_PARAMETER);
+    CHECK_OK(ts_world_crushed_substeps(world, &n));
+    CHECK(n == 1);
+    CHECK_OK(ts_world_set_crushed_substeps(world, 2));
+    CHECK_ST(ts_world_set_crushed_substeps(world, 0), TS_STATUS_INVALID_ARGUMENT);
+    CHECK_ST(ts_world_set_crushed_substeps(world, settings.max_substeps + 1),
+             TS_STATUS_INVALID_ARGUMENT);
+    settings.iterations = 2;
+    CHECK_OK(ts_world_set_settings(world, &settings));
+    CHECK_OK(ts_world_crushed_substeps(world, &n));
+    CHECK(n == 2);
+    ts_world_free(world);
+}
+
 /* The functions that cover the rest of the Rust API: body state, fixed flags, particle radius,
  * pair and tool friction, convex-hull and triangle-array tools, removing a tool, and a capsule
  * of half-height 0 (a sphere). Uses the lattice of build_lattice (edge CELLS * h). */
@@ -553,6 +576,7 @@ int main(void) {
     test_settle(h);
     test_profile(h);
     test_schemes(h);
+    test_crushed_substeps();
     test_coverage(h);
     test_grasp(h);
     test_needle(h);

@@ -632,7 +632,8 @@ enum ts_status ts_world_get_settings(const struct ts_world *world, struct ts_set
 
 /**
  * Replace the settings (validated as in ts_world_new; the world is unchanged on error). The
- * world keeps its schemes (ts_world_set_schemes), which ts_settings does not carry.
+ * world keeps its schemes (ts_world_set_schemes) and its crushed-step substeps
+ * (ts_world_set_crushed_substeps), which ts_settings does not carry.
  *
  * # Safety
  *
@@ -1622,6 +1623,31 @@ enum ts_status ts_world_set_schemes(struct ts_world *world, uint32_t elastic, ui
  * `world` is NULL or a live handle; `out_schemes` is NULL or writable.
  */
 enum ts_status ts_world_schemes(const struct ts_world *world, struct ts_schemes *out_schemes);
+
+/**
+ * From the next step on, take at least `substeps` substeps (1..=max_substeps of the world's
+ * settings) in a step that starts with the tissue at a tool compressed: a tetrahedron with a
+ * corner within a particle radius of a tool below half its rest volume, now or two steps
+ * ahead (the elasticity on tetrahedra, the volume constraints on). 1, the default, adds none;
+ * 2 keeps small probes pressed deep out of the tissue at twice the cost of the steps that
+ * compress it (docs/SETTINGS.md, "Deep presses"). 0 or more than max_substeps returns
+ * TS_STATUS_INVALID_ARGUMENT and changes nothing.
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle.
+ */
+enum ts_status ts_world_set_crushed_substeps(struct ts_world *world, uint32_t substeps);
+
+/**
+ * Write the world's crushed-step substeps into *out_substeps (1 until
+ * ts_world_set_crushed_substeps).
+ *
+ * # Safety
+ *
+ * `world` is NULL or a live handle; `out_substeps` is NULL or writable.
+ */
+enum ts_status ts_world_crushed_substeps(const struct ts_world *world, uint32_t *out_substeps);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -60,6 +60,8 @@ pub mod profile;
 
 pub mod scheme;
 
+pub mod crushed_substeps;
+
 pub use body::{ts_body_options, ts_material};
 pub use cut::ts_cut_report;
 pub use grasp::ts_grasp_options;

@@ -306,7 +306,8 @@ pub unsafe extern "C" fn ts_world_get_settings(
 }
 
 /// Replace the settings (validated as in ts_world_new; the world is unchanged on error). The
-/// world keeps its schemes (ts_world_set_schemes), which ts_settings does not carry.
+/// world keeps its schemes (ts_world_set_schemes) and its crushed-step substeps
+/// (ts_world_set_crushed_substeps), which ts_settings does not carry.
 ///
 /// # Safety
 ///
@@ -322,11 +323,13 @@ pub unsafe extern "C" fn ts_world_set_settings(
         let h = unsafe { world_mut(world)? };
         // SAFETY: checked non-NULL; readable by contract.
         let s = unsafe { *settings }.to_settings()?;
-        // The schemes are not in ts_settings: the world keeps its own (ts_world_set_schemes).
+        // The schemes and the crushed-step substeps are not in ts_settings: the world keeps
+        // its own (ts_world_set_schemes, ts_world_set_crushed_substeps).
         h.mutate(|w| {
             w.set_settings(Settings {
                 elastic_scheme: w.settings().elastic_scheme,
                 volume_scheme: w.settings().volume_scheme,
+                crushed_substeps: w.settings().crushed_substeps,
                 ..s
             })
         })
