@@ -192,6 +192,7 @@ crate::fmi2_variables! {
         VOLUME_SCHEME = Variable::enumeration("volume_scheme", Parameter, Fixed, &VOLUME_SCHEME_TYPE, 0, "Volume constraints: 0 one per particle's dual cell (the default), 1 one per tetrahedron (the paper's)"),
         DAMPING_STIFFNESS = param("damping_stiffness", Tunable, "s", 0.0, Some(0.0), "Stiffness-proportional damping time beta: dashpots on the tetrahedra's edges, filtered implicitly (no substeps added); with the paper's particles, explicit pair dashpots that can add substeps"),
         MIN_SUBSTEPS = Variable::integer("min_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps per internal step (more where the stability limit or a fast tool needs them)"),
+        CRUSHED_SUBSTEPS = Variable::integer("crushed_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps of an internal step that starts with the tissue at the tool compressed (a tetrahedron touching it below half its rest volume, now or two steps ahead); 1 adds none, 2 keeps small probes pressed deep out of the tissue at twice the cost of those steps"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {
@@ -530,6 +531,7 @@ fn settings_from(store: &Store, base: &Settings, dt: f64) -> Settings {
     };
     s.damping_stiffness = store.real(vr::DAMPING_STIFFNESS);
     s.min_substeps = store.integer(vr::MIN_SUBSTEPS).clamp(1, 64) as u32;
+    s.crushed_substeps = store.integer(vr::CRUSHED_SUBSTEPS).clamp(1, 64) as u32;
     s
 }
 

@@ -101,6 +101,8 @@ def test_archive_layout_and_model_description(md, unzipdir):
     assert by_name["elastic_scheme"].type == "Enumeration"
     assert by_name["volume_scheme"].declaredType.name == "VolumeScheme"
     assert by_name["damping_stiffness"].unit == "s"
+    crushed = by_name["crushed_substeps"]
+    assert crushed.type == "Integer" and crushed.start == "1"
     assert by_name["contact_count"].type == "Integer"
     assert by_name["mesh"].start == "organ.vtk"
 
@@ -203,12 +205,15 @@ def deep_press(fmu_path, start_values):
                         output=["force_z", "contact_count"])
 
 
-def test_deep_press_settings_keep_a_probe_on_the_tissue_through_a_15_cm_press(fmu_path):
-    """With two substeps and 0.3 ms of stiffness damping (docs/SETTINGS.md, "Deep presses") the
-    default scene's probe driven 20 cm along -z at 0.5 m/s stays in contact and is pushed back at
-    every step from first contact to 15 cm of travel. tests/contact_deep_press.rs measures the
-    geometry on the library."""
-    r = deep_press(fmu_path, {"min_substeps": 2, "damping_stiffness": 3e-4})
+@pytest.mark.parametrize("settings", [{"crushed_substeps": 2},
+                                      {"min_substeps": 2, "damping_stiffness": 3e-4}])
+def test_deep_press_settings_keep_a_probe_on_the_tissue_through_a_15_cm_press(fmu_path, settings):
+    """With two substeps where the tissue at the tool is compressed (docs/SETTINGS.md, "Deep
+    presses"), or two substeps everywhere with 0.3 ms of stiffness damping, the default scene's
+    probe driven 20 cm along -z at 0.5 m/s stays in contact and is pushed back at every step from
+    first contact to 15 cm of travel. tests/contact_deep_press.rs measures the geometry on the
+    library."""
+    r = deep_press(fmu_path, settings)
     t, count = r["time"], r["contact_count"]
     first = t[np.argmax(count > 0)]
     pressing = (t > first) & (t <= 0.3)
