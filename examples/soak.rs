@@ -10,9 +10,11 @@
 //! lands.
 //!
 //! ```text
-//! cargo run --release --example soak -- [STEPS] [--self-contact]    # default 1000000 steps
+//! cargo run --release --example soak -- [STEPS] [--self-contact] [--crushed-substeps N] [--seed N]
 //! ```
-//! `--self-contact` turns on `Settings::self_contact` (off by default).
+//! `STEPS` defaults to 1000000. `--self-contact` turns on `Settings::self_contact` (off by
+//! default); `--crushed-substeps N` sets `Settings::crushed_substeps` (1 by default); `--seed`
+//! the random paths' seed (a non-zero integer; the default is the one of the runs reported).
 //!
 //! Prints one line per phase (tool shape × contact mode) and a summary; exits non-zero if a
 //! non-finite position escaped or the resident memory grew by more than 1 MB within a phase
@@ -126,17 +128,25 @@ fn probes() -> Vec<Probe> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let self_contact = std::env::args().any(|a| a == "--self-contact");
-    let total: u64 = match std::env::args().skip(1).find(|a| a != "--self-contact") {
-        Some(s) => s.parse()?,
-        None => 1_000_000,
-    };
+    let (mut total, mut self_contact, mut crushed_substeps) = (1_000_000, false, 1);
+    let mut seed = 0x50a4_2026;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--self-contact" => self_contact = true,
+            "--crushed-substeps" => {
+                crushed_substeps = args.next().ok_or("--crushed-substeps N")?.parse()?
+            }
+            "--seed" => seed = args.next().ok_or("--seed N")?.parse()?,
+            steps => total = steps.parse()?,
+        }
+    }
     let phases: Vec<(ContactMode, Probe)> = [ContactMode::ExactShape, ContactMode::SampledPoints]
         .into_iter()
         .flat_map(|m| probes().into_iter().map(move |p| (m, p)))
         .collect();
     let per_phase = (total / phases.len() as u64).max(1);
-    let mut rng = Rng(0x50a4_2026);
+    let mut rng = Rng(seed);
     let (mut all_steps, mut all_diverged, mut escaped) = (0u64, 0u64, 0u64);
     let mut worst_growth = 0i64;
     let start = std::time::Instant::now();
@@ -151,6 +161,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let settings = Settings {
             contact_mode: mode,
             self_contact,
+            crushed_substeps,
             ..Settings::default()
         };
         let dt = settings.dt;
