@@ -1627,8 +1627,9 @@ enum ts_status ts_world_schemes(const struct ts_world *world, struct ts_schemes 
 /**
  * From the next step on, take at least `substeps` substeps (1..=max_substeps of the world's
  * settings) in a step that starts with the tissue at a tool compressed: a tetrahedron with a
- * corner within a particle radius of a tool below half its rest volume, now or two steps
- * ahead (the elasticity on tetrahedra, the volume constraints on). 1, the default, adds none;
+ * corner within a particle radius of a tool's bounding box below half its rest volume, now or
+ * two steps ahead (the elasticity on tetrahedra, the volume constraints on). 1, the default,
+ * adds none;
  * 2 keeps small probes pressed deep out of the tissue at twice the cost of the steps that
  * compress it (docs/SETTINGS.md, "Deep presses"). 0 or more than max_substeps returns
  * TS_STATUS_INVALID_ARGUMENT and changes nothing.

@@ -48,42 +48,21 @@ fn allocations_during(f: impl FnOnce()) -> usize {
 
 #[test]
 fn steps_after_the_first_do_not_allocate() {
-    // (contact mode, threads, volume scheme, elastic scheme, self-contact)
+    // (contact mode, threads, volume scheme, elastic scheme, self-contact, crushed substeps)
     use ElasticScheme::{PointBased, Tetrahedra};
     use VolumeScheme::DualCells;
-    for (mode, threads, volume_scheme, elastic_scheme, self_contact) in [
-        (
-            ContactMode::ExactShape,
-            1,
-            VolumeScheme::Tetrahedra,
-            PointBased,
-            false,
-        ),
-        (
-            ContactMode::SampledPoints,
-            1,
-            VolumeScheme::Tetrahedra,
-            PointBased,
-            false,
-        ),
-        (
-            ContactMode::ExactShape,
-            2,
-            VolumeScheme::Tetrahedra,
-            PointBased,
-            false,
-        ),
-        (ContactMode::ExactShape, 1, DualCells, PointBased, false),
-        (ContactMode::ExactShape, 2, DualCells, PointBased, false),
-        (ContactMode::ExactShape, 1, DualCells, Tetrahedra, false),
-        (ContactMode::ExactShape, 2, DualCells, Tetrahedra, false),
-        (
-            ContactMode::ExactShape,
-            1,
-            VolumeScheme::Tetrahedra,
-            PointBased,
-            true,
-        ),
+    let per_tet = VolumeScheme::Tetrahedra;
+    let (exact, sampled) = (ContactMode::ExactShape, ContactMode::SampledPoints);
+    for (mode, threads, volume_scheme, elastic_scheme, self_contact, crushed_substeps) in [
+        (exact, 1, per_tet, PointBased, false, 1),
+        (sampled, 1, per_tet, PointBased, false, 1),
+        (exact, 2, per_tet, PointBased, false, 1),
+        (exact, 1, DualCells, PointBased, false, 1),
+        (exact, 2, DualCells, PointBased, false, 1),
+        (exact, 1, DualCells, Tetrahedra, false, 1),
+        (exact, 2, DualCells, Tetrahedra, false, 1),
+        (exact, 1, DualCells, Tetrahedra, false, 2),
+        (exact, 1, per_tet, PointBased, true, 1),
     ] {
         let settings = Settings {
             contact_mode: mode,
@@ -91,6 +70,7 @@ fn steps_after_the_first_do_not_allocate() {
             volume_scheme,
             elastic_scheme,
             self_contact,
+            crushed_substeps,
             ..Settings::default()
         };
         let (mut world, a, b) = two_bodies_stacked(settings);

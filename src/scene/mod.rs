@@ -35,6 +35,7 @@ use crate::scene::grasp_state::Grasp;
 use crate::scene::needle_state::Needle;
 use crate::scene::settings::{ElasticScheme, Settings};
 use crate::scene::tool::{Tool, ToolLoad};
+use parry3d_f64::bounding_volume::BoundingVolume;
 
 /// How many steps ahead (dimensionless) [`Settings::crushed_substeps`] looks for tetrahedra at
 /// a tool going below half their volume, at their corners' velocities. Switching on the
@@ -200,22 +201,24 @@ impl Scene {
 
     /// Whether the tissue at a tool is compressed, so that a step with
     /// [`Settings::crushed_substeps`] takes them: a tetrahedron with a corner within a particle
-    /// radius of a tool (not a blade) at its pose is below [`COMPRESSED_RATIO`] of its rest
-    /// volume at the start of the step, or will be [`CRUSH_LOOKAHEAD_STEPS`] steps later at its
-    /// corners' velocities. Reads the state only (positions, velocities, tool poses). Cost: a
-    /// distance per particle, and the tetrahedra around the few particles at a tool.
+    /// radius of a tool's bounding box (not a blade's; at the tool's pose) is below
+    /// [`COMPRESSED_RATIO`] of its rest volume at the start of the step, or will be
+    /// [`CRUSH_LOOKAHEAD_STEPS`] steps later at its corners' velocities. Reads the state only
+    /// (positions, velocities, tool poses). Cost: a distance per particle, a point in a box for
+    /// those within the tool's bounding sphere, and the tetrahedra around those in the box.
     fn compressed_at_a_tool(&self) -> bool {
         let tools = self.tools.iter().flatten().filter(|slot| !slot.blade);
         let ahead = CRUSH_LOOKAHEAD_STEPS * self.settings.dt;
         tools.map(|slot| &slot.tool).any(|tool| {
+            let (iso, local_box) = (tool.pose.isometry(), tool.shape.compute_local_aabb());
             self.bodies.iter().any(|body| {
                 let reach = body.model.particle_radius;
-                let near = tool.bounding_radius + reach;
+                let (near, within) = (tool.bounding_radius + reach, local_box.loosened(reach));
                 let (x, v) = (&body.state.x, &body.state.v);
                 let elements = &body.model.tet_elements;
                 (x.iter().enumerate()).any(|(i, p)| {
                     (p - tool.pose.position).norm_squared() < near * near
-                        && tool.signed_distance(&tool.pose, p) < reach
+                        && within.contains_local_point(&iso.inverse_transform_point(&(*p).into()))
                         && elements.compressed_around(i, (x, v), ahead, COMPRESSED_RATIO)
                 })
             })

@@ -70,9 +70,10 @@ pub struct Settings {
     /// elastic step would be unstable (see [`Settings::stability_margin`]).
     pub min_substeps: u32,
     /// Smallest number of substeps (≥ 1) of a step that starts with the tissue at a tool
-    /// compressed: a tetrahedron with a corner within a particle radius of a tool below half
-    /// its rest volume, now or two steps ahead at its corners' velocities. Applies with the
-    /// elasticity on tetrahedra and the volume constraints on (where the crush guard runs).
+    /// compressed: a tetrahedron with a corner within a particle radius of a tool's bounding box
+    /// below half its rest volume, now or two steps ahead at its corners' velocities. Applies
+    /// with the elasticity on tetrahedra and the volume constraints on (where the crush guard
+    /// runs).
     /// 1 (the default) adds none. 2 keeps small probes pressed deep out of the tissue (a 1 mm
     /// sphere 3 cm into organs of another mesher, a 1 cm probe 20 cm into the default organ)
     /// at twice the cost of the steps that compress it, which in a deep press is most of them
