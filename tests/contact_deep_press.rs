@@ -279,7 +279,7 @@ fn deep_press_settings() -> Settings {
 /// [`deep_press_settings`]: the tissue wraps round the probe and the probe stays outside it
 /// (measured: its centre never inside, the surface 0.60 mm outside it; 598–753 of the 816 steps
 /// take two substeps). Not asserted: the organ swings off the probe for up to 76 of the 404
-/// pressing steps, and up to 63 contact steps have a forward component as the swinging tissue
+/// pressing steps, and up to 62 contact steps have a forward component as the swinging tissue
 /// drags on the probe. With the default settings the probe ends inside on 236, 0, 67 and 166
 /// of the 816 steps (+x, −x, +z, −z; docs/VALIDATION.md).
 #[test]
