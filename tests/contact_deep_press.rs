@@ -201,9 +201,21 @@ fn check_probes(
     goal: &str,
     fails: impl Fn(Real, &Press) -> bool,
 ) {
+    check_probes_from(organ, plan, probes, &sides(organ), goal, fails)
+}
+
+/// [`check_probes`] from the given `sides` only.
+fn check_probes_from(
+    organ: &Hanging,
+    plan: &Plan,
+    probes: &[(ToolShape, Real)],
+    sides: &[(&'static str, Vec3, Vec3)],
+    goal: &str,
+    fails: impl Fn(Real, &Press) -> bool,
+) {
     let mut failures = Vec::new();
     for (probe, radius) in probes.iter().cloned() {
-        for (side, direction, through) in sides(organ) {
+        for &(side, direction, through) in sides {
             let p = press(organ, plan, (probe.clone(), radius), (direction, through));
             let what = format!("{probe:?}, pressed along {side}: {p:?}");
             eprintln!("{what}");
@@ -355,18 +367,15 @@ fn a_one_millimetre_sphere_stays_outside_the_gmsh_liver_with_the_deep_press_sett
         ..three_cm()
     };
     let organ = hanging_organ(common::liver("liver_gmsh"));
+    let reached: Vec<_> = sides(&organ).into_iter().filter(|s| s.0 != "+z").collect();
     let radius = 0.001;
-    let probe = (ToolShape::Sphere { radius }, radius);
-    for (side, direction, through) in sides(&organ).into_iter().filter(|s| s.0 != "+z") {
-        let p = press(&organ, &plan, probe.clone(), (direction, through));
-        let what = format!("the 1 mm sphere pressed along {side}: {p:?}");
-        eprintln!("{what}");
-        assert!(
-            p.contact_steps * 5 > p.pressing_steps * 2,
-            "{what}: barely touched"
-        );
-        assert_eq!(p.centre_inside, 0, "{what}");
-        assert!(p.deepest <= MOST_INSIDE * radius, "{what}");
-        assert_eq!(p.pulling, 0, "{what}");
-    }
+    check_probes_from(
+        &organ,
+        &plan,
+        &[(ToolShape::Sphere { radius }, radius)],
+        &reached,
+        "the 1 mm sphere's centre inside the liver, the surface more than a fifth of its radius \
+         inside it, or a contact step pulling it in",
+        |radius, p| p.centre_inside > 0 || p.deepest > MOST_INSIDE * radius || p.pulling > 0,
+    );
 }
