@@ -10,10 +10,12 @@
 //! lands.
 //!
 //! ```text
-//! cargo run --release --example soak -- [STEPS] [--self-contact] [--crushed-substeps N] [--seed N]
+//! cargo run --release --example soak -- [STEPS] [--self-contact] [--crushed-substeps N]
+//!     [--damping S] [--seed N]
 //! ```
 //! `STEPS` defaults to 1000000. `--self-contact` turns on `Settings::self_contact` (off by
-//! default); `--crushed-substeps N` sets `Settings::crushed_substeps` (1 by default); `--seed`
+//! default); `--crushed-substeps N` sets `Settings::crushed_substeps` (1 by default);
+//! `--damping S` the stiffness-proportional damping time β (s, `Settings::damping_stiffness`); `--seed`
 //! the random paths' seed (a non-zero integer; the default is the one of the runs reported).
 //!
 //! Prints one line per phase (tool shape × contact mode) and a summary; exits non-zero if a
@@ -129,6 +131,7 @@ fn probes() -> Vec<Probe> {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut total, mut self_contact, mut crushed_substeps) = (1_000_000, false, 1);
+    let mut damping_stiffness = Settings::default().damping_stiffness;
     let mut seed = 0x50a4_2026;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -137,6 +140,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--crushed-substeps" => {
                 crushed_substeps = args.next().ok_or("--crushed-substeps N")?.parse()?
             }
+            "--damping" => damping_stiffness = args.next().ok_or("--damping S")?.parse()?,
             "--seed" => seed = args.next().ok_or("--seed N")?.parse()?,
             steps => total = steps.parse()?,
         }
@@ -162,6 +166,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             contact_mode: mode,
             self_contact,
             crushed_substeps,
+            damping_stiffness,
             ..Settings::default()
         };
         let dt = settings.dt;
