@@ -167,7 +167,7 @@ pub struct Settings {
     /// Mass-proportional damping rate alpha (1/s). Default 2.
     pub damping_mass: Real,
     /// Stiffness-proportional damping time beta (s): dashpots on the mesh edges, implicit.
-    /// Default 0 (0.0003 recommended for scenes that should come to rest quickly).
+    /// Default 0.0003 (0: none).
     pub damping_stiffness: Real,
     /// Hourglass-control stiffness (dimensionless, times the shear modulus). Default 0.25.
     pub hourglass_stiffness: Real,

@@ -135,7 +135,7 @@ class Settings:
     """Mass-proportional damping rate α (1/s). Default 2."""
     damping_stiffness: float
     """Stiffness-proportional damping time β (s): dashpots on the mesh edges, implicit (adds no
-    substeps). Default 0 (0.0003 recommended for scenes that should come to rest quickly)."""
+    substeps). Default 0.0003 (0: none)."""
     hourglass_stiffness: float
     """Hourglass-control stiffness (dimensionless, times the shear modulus). Default 0.25."""
     volume_constraints: bool

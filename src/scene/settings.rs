@@ -96,8 +96,8 @@ pub struct Settings {
     /// Mass-proportional (ambient) damping rate α (1/s): each substep of length `h` (s) scales
     /// particle velocities by `1/(1 + α·h)`. Models the viscous surroundings of an organ; damps rigid motion too.
     pub damping_mass: Real,
-    /// Stiffness-proportional damping time β (s; default 0, 0.3 ms recommended for scenes
-    /// that should come to rest quickly, docs/SETTINGS.md): a dashpot along each mesh
+    /// Stiffness-proportional damping time β (s; default 0.3 ms, 0 for none; docs/SETTINGS.md,
+    /// docs/VALIDATION.md for how soon a struck organ comes to rest): a dashpot along each mesh
     /// edge with coefficient β·k_ij (k_ij the edge's share of the tetrahedra's stiffness, N/m),
     /// for both elastic schemes. Central and zero under rigid motion, so momentum is conserved.
     /// Solved implicitly (one Jacobi step on each substep's kicked velocities,
@@ -218,7 +218,7 @@ impl Default for Settings {
             stability_margin: 0.9,
             mass_scaling: true,
             damping_mass: 2.0,
-            damping_stiffness: 0.0,
+            damping_stiffness: 3.0e-4,
             hourglass_stiffness: 0.25,
             volume_constraints: true,
             volumetric_split: true,
