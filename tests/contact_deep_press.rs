@@ -289,10 +289,10 @@ fn deep_press_settings() -> Settings {
 
 /// A 1 cm probe driven 20 cm into the organ (14–21 cm across) at 0.5 m/s and withdrawn, under
 /// [`deep_press_settings`]: the tissue wraps round the probe and the probe stays outside it
-/// (measured: its centre never inside, the surface 0.60 mm outside it; 598–753 of the 816 steps
-/// take two substeps). Not asserted: the organ swings off the probe for up to 76 of the 404
-/// pressing steps, and up to 62 contact steps have a forward component as the swinging tissue
-/// drags on the probe. With the default settings the probe ends inside on 236, 0, 67 and 166
+/// (measured: its centre never inside, the surface 0.60 mm outside it; 598–736 of the 816 steps
+/// take two substeps). Not asserted: the organ swings off the probe for up to 75 of the 404
+/// pressing steps, and up to 63 contact steps have a forward component as the swinging tissue
+/// drags on the probe. With the default settings the probe ends inside on 234, 0, 65 and 109
 /// of the 816 steps (+x, −x, +z, −z; docs/VALIDATION.md).
 #[test]
 fn a_one_centimetre_probe_pressed_20_cm_stays_outside_with_the_deep_press_settings() {
@@ -317,7 +317,7 @@ fn a_one_centimetre_probe_pressed_20_cm_stays_outside_with_the_deep_press_settin
 /// to 15 cm): spheres of 2.5 to 10 mm, the rod and the cube, 3 cm from four sides. The centre
 /// never inside, the surface within a fifth of the radius, every contact step pushing back
 /// (measured: the surface never inside any probe, no step pulling). Not asserted: the 1 mm
-/// sphere, which gets in along −x (centre inside on 1,209 of 1,780 steps) and holds from the
+/// sphere, which gets in along −x (centre inside on 1,226 of 1,780 steps) and holds from the
 /// other three sides. Before the crush guard and the contact were alternated, 13 of these 24
 /// presses failed: the centre inside in 9 (the 1 mm sphere from every side), the surface up to
 /// 3.7 mm into the 5 mm sphere.
@@ -356,7 +356,7 @@ fn a_one_millimetre_sphere_stays_outside_an_organ_from_another_mesher_with_the_d
 }
 
 /// The 1 mm sphere on the gmsh liver, which the defaults let in along +x and −z (centre inside
-/// on 1,281 and 1,321 of the 1,780 steps), under [`deep_press_settings`]: the centre never
+/// on 1,321 and 1,320 of the 1,780 steps), under [`deep_press_settings`]: the centre never
 /// inside, the surface within a fifth of the radius, every contact step pushing back (measured:
 /// the surface 0.46 mm outside it, no step pulling; 592–1,499 of the 1,780 steps take two
 /// substeps). Along +z the press line misses this liver.
