@@ -1,7 +1,9 @@
-//! `Settings::crushed_substeps`: a step that starts with a tetrahedron touching a tool
-//! compressed below half its rest volume takes at least that many substeps; otherwise the step
-//! substeps as before. The rule reads the state at the start of the step only (positions, the
-//! tools' poses), so a restored state steps the same.
+//! Substeps where the tissue at a tool is compressed. `Settings::crushed_substeps`: a step that
+//! starts with a tetrahedron touching a tool compressed below half its rest volume takes at
+//! least that many substeps. By default, whatever that setting: such a step takes twice the
+//! substeps it would otherwise when the compressed tetrahedron is longer (its longest rest edge)
+//! than the tool is wide. Otherwise the step substeps as before. The rules read the state at the
+//! start of the step only (positions, the tools' poses), so a restored state steps the same.
 
 mod common;
 
@@ -28,15 +30,24 @@ fn flattened_box(settings: Settings, fraction: Real) -> (World, BodyId) {
     (world, body)
 }
 
-/// A sphere of [`PROBE`] radius resting on the flattened top face of a box of 6 cm flattened to
+/// The radius (m) of a probe wider than the box's tetrahedra (their longest edges are at most
+/// the 1 cm cells' diagonal, 1.73 cm).
+const WIDE_PROBE: Real = 0.01;
+
+/// A sphere of `radius` (m) resting on the flattened top face of a box of 6 cm flattened to
 /// `fraction`, or `away` from it (m, upwards).
-fn probe_on_top(world: &mut World, fraction: Real, away: Real) {
+fn sphere_on_top(world: &mut World, radius: Real, fraction: Real, away: Real) {
     let top = 0.06 * fraction;
-    let centre = Vec3::new(0.03, top + PROBE + away, 0.03);
-    let sphere = ToolShape::Sphere { radius: PROBE };
+    let centre = Vec3::new(0.03, top + radius + away, 0.03);
+    let sphere = ToolShape::Sphere { radius };
     world
         .add_tool(sphere, Pose::at(centre), &ToolOptions::default())
         .unwrap();
+}
+
+/// [`sphere_on_top`] of [`WIDE_PROBE`] radius.
+fn probe_on_top(world: &mut World, fraction: Real, away: Real) {
+    sphere_on_top(world, WIDE_PROBE, fraction, away);
 }
 
 fn crushed(substeps: u32) -> Settings {
@@ -83,7 +94,7 @@ fn tissue_above_half_its_volume_or_far_from_the_tool_takes_one_substep() {
     assert_eq!(
         substeps_with_probe(crushed(1), 0.4, 0.0),
         one,
-        "the default adds none"
+        "the default adds none for a probe wider than the tetrahedra"
     );
     let paper = common::paper(crushed(2));
     assert_eq!(
@@ -91,6 +102,42 @@ fn tissue_above_half_its_volume_or_far_from_the_tool_takes_one_substep() {
         one,
         "the paper's particles have no crush guard"
     );
+}
+
+/// A probe narrower than the tetrahedra it crushes (a 5 mm sphere on 1 cm cells): by default
+/// the step takes twice the substeps it would otherwise, before `crushed_substeps`; not where
+/// the tissue is above half its volume, nor on the paper's particles (no crush guard).
+#[test]
+fn a_probe_narrower_than_the_crushed_tetrahedra_doubles_the_substeps() {
+    let narrow = |settings: Settings, fraction: Real| {
+        let (mut world, _) = flattened_box(settings, fraction);
+        sphere_on_top(&mut world, PROBE, fraction, 0.0);
+        world.substeps_needed()
+    };
+    assert_eq!(narrow(crushed(1), 0.4), (2, false));
+    let at_least_three = Settings {
+        min_substeps: 3,
+        ..crushed(1)
+    };
+    assert_eq!(narrow(at_least_three, 0.4), (6, false));
+    assert_eq!(
+        narrow(crushed(5), 0.4),
+        (5, false),
+        "crushed_substeps above twice"
+    );
+    assert_eq!(
+        narrow(crushed(1), 0.6),
+        (1, false),
+        "compressed to 0.6 only"
+    );
+    assert_eq!(
+        narrow(common::paper(crushed(1)), 0.4),
+        (1, false),
+        "the paper's particles"
+    );
+    let (mut world, _) = flattened_box(crushed(1), 0.4);
+    sphere_on_top(&mut world, PROBE, 0.4, 0.0);
+    assert_eq!(world.step().unwrap().substeps, 2);
 }
 
 #[test]

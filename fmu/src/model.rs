@@ -192,7 +192,7 @@ crate::fmi2_variables! {
         VOLUME_SCHEME = Variable::enumeration("volume_scheme", Parameter, Fixed, &VOLUME_SCHEME_TYPE, 0, "Volume constraints: 0 one per particle's dual cell (the default), 1 one per tetrahedron (the paper's)"),
         DAMPING_STIFFNESS = param("damping_stiffness", Tunable, "s", 3.0e-4, Some(0.0), "Stiffness-proportional damping time beta: dashpots on the tetrahedra's edges, filtered implicitly (no substeps added), for both elastic schemes; 0 for none"),
         MIN_SUBSTEPS = Variable::integer("min_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps per internal step (more where the stability limit or a fast tool needs them)"),
-        CRUSHED_SUBSTEPS = Variable::integer("crushed_substeps", Parameter, Tunable, Some(2), Some(1), Some(64), "Fewest solver substeps of an internal step that starts with the tissue at the tool compressed (a tetrahedron touching it below half its rest volume, now or two steps ahead); 2 (the FMU's default, unlike the library's 1) keeps probes pressed deep out of the tissue at twice the cost of those steps, 1 adds none"),
+        CRUSHED_SUBSTEPS = Variable::integer("crushed_substeps", Parameter, Tunable, Some(1), Some(1), Some(64), "Fewest solver substeps of an internal step that starts with the tissue at the tool compressed (a tetrahedron touching it below half its rest volume, now or two steps ahead); 1 adds none (where the tool is narrower than the crushed tetrahedra the step takes twice its substeps anyway), 2 keeps wide probes pressed deep out of the tissue at twice the cost of those steps"),
     ];
 }
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32) -> UnitDefinition {

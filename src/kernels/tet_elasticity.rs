@@ -184,26 +184,38 @@ impl TetElements {
         })
     }
 
-    /// Whether a tetrahedron with corner `i` is below `ratio` (dimensionless) of its rest volume
-    /// at positions `x` (m), or will be after `time` (s) at velocities `v` (m/s).
+    /// The longest rest edge (m) of the tetrahedra with corner `i` that are below `ratio`
+    /// (dimensionless) of their rest volume at positions `x` (m), or will be after `time` (s) at
+    /// velocities `v` (m/s); `None` when none is. `rest` holds the rest positions (m).
     pub(crate) fn compressed_around(
         &self,
         i: usize,
         (x, v): (&[Vec3], &[Vec3]),
         time: Real,
         ratio: Real,
-    ) -> bool {
+        rest: &[Vec3],
+    ) -> Option<Real> {
         let (start, end) = (self.corner_offsets[i], self.corner_offsets[i + 1]);
-        self.corners[start as usize..end as usize]
+        let compressed = self.corners[start as usize..end as usize]
             .iter()
-            .any(|&slot| {
+            .filter_map(|&slot| {
                 let e = slot as usize / 4;
                 let chunk = &self.chunks[e / LANES];
                 let corners = chunk.tets[e % LANES].map(|k| k as usize);
                 let floor = ratio * chunk.volume.to_array()[e % LANES];
                 let below = |[a, b, c, d]: [Vec3; 4]| tet_volume(&a, &b, &c, &d) < floor;
-                below(corners.map(|k| x[k])) || below(corners.map(|k| x[k] + v[k] * time))
+                (below(corners.map(|k| x[k])) || below(corners.map(|k| x[k] + v[k] * time)))
+                    .then_some(corners)
+            });
+        compressed
+            .map(|corners| {
+                let edge = |(a, b): (usize, usize)| (rest[corners[a]] - rest[corners[b]]).norm();
+                [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                    .map(edge)
+                    .into_iter()
+                    .fold(0.0, Real::max)
             })
+            .reduce(Real::max)
     }
 
     /// The deformation gradient (dimensionless) of tetrahedron `t` at positions `x` (m).

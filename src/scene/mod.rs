@@ -45,6 +45,15 @@ use parry3d_f64::bounding_volume::BoundingVolume;
 /// through the wobble (3,000 steps).
 const CRUSH_LOOKAHEAD_STEPS: Real = 2.0;
 
+/// What [`Scene::crushed_at_tools`] finds at the tools.
+#[derive(Debug, Clone, Copy, Default)]
+struct CrushedAtTools {
+    /// A tetrahedron at a tool is compressed.
+    any: bool,
+    /// One of them is longer than the tool is wide.
+    by_a_thinner_tool: bool,
+}
+
 /// Fraction of the divergence speed bound above which a tool's motion is a jump (placed, not
 /// swept). Tissue pushed by a swept tool moves faster than the tool: friction drags it along
 /// and compressed tissue springs back (measured in `tests/api_robustness.rs`, friction 1,
@@ -199,30 +208,46 @@ impl Scene {
             && self.tools.iter().flatten().any(|slot| !slot.blade)
     }
 
-    /// Whether the tissue at a tool is compressed, so that a step with
-    /// [`Settings::crushed_substeps`] takes them: a tetrahedron with a corner within a particle
-    /// radius of a tool's bounding box (not a blade's; at the tool's pose) is below
+    /// Whether the tissue at a tool is compressed: a tetrahedron with a corner within a
+    /// particle radius of a tool's bounding box (not a blade's; at the tool's pose) is below
     /// [`COMPRESSED_RATIO`] of its rest volume at the start of the step, or will be
-    /// [`CRUSH_LOOKAHEAD_STEPS`] steps later at its corners' velocities. Reads the state only
-    /// (positions, velocities, tool poses). Cost: a distance per particle, a point in a box for
-    /// those within the tool's bounding sphere, and the tetrahedra around those in the box.
-    fn compressed_at_a_tool(&self) -> bool {
+    /// [`CRUSH_LOOKAHEAD_STEPS`] steps later at its corners' velocities; and whether such a
+    /// tetrahedron is longer (its longest rest edge) than the tool is wide
+    /// ([`ToolShape::width`](crate::ToolShape)). Reads the state only (positions, velocities,
+    /// tool poses). Cost: a distance per particle and tool, a point in a box for those within
+    /// the tool's bounding sphere, and the tetrahedra around those in the box.
+    fn crushed_at_tools(&self) -> CrushedAtTools {
+        let mut found = CrushedAtTools::default();
         let tools = self.tools.iter().flatten().filter(|slot| !slot.blade);
         let ahead = CRUSH_LOOKAHEAD_STEPS * self.settings.dt;
-        tools.map(|slot| &slot.tool).any(|tool| {
+        for tool in tools.map(|slot| &slot.tool) {
             let (iso, local_box) = (tool.pose.isometry(), tool.shape.compute_local_aabb());
-            self.bodies.iter().any(|body| {
+            let width = tool.description.width();
+            for body in &self.bodies {
                 let reach = body.model.particle_radius;
                 let (near, within) = (tool.bounding_radius + reach, local_box.loosened(reach));
                 let (x, v) = (&body.state.x, &body.state.v);
                 let elements = &body.model.tet_elements;
-                (x.iter().enumerate()).any(|(i, p)| {
-                    (p - tool.pose.position).norm_squared() < near * near
-                        && within.contains_local_point(&iso.inverse_transform_point(&(*p).into()))
-                        && elements.compressed_around(i, (x, v), ahead, COMPRESSED_RATIO)
-                })
-            })
-        })
+                for (i, p) in x.iter().enumerate() {
+                    let at_tool = (p - tool.pose.position).norm_squared() < near * near
+                        && within.contains_local_point(&iso.inverse_transform_point(&(*p).into()));
+                    let longest = at_tool
+                        .then(|| {
+                            let rest = &body.model.rest;
+                            elements.compressed_around(i, (x, v), ahead, COMPRESSED_RATIO, rest)
+                        })
+                        .flatten();
+                    if let Some(longest) = longest {
+                        found.any = true;
+                        if width.is_some_and(|w| longest > w) {
+                            found.by_a_thinner_tool = true;
+                            return found;
+                        }
+                    }
+                }
+            }
+        }
+        found
     }
 
     /// Substeps the next step needs, and whether `max_substeps` clamped that number: enough
@@ -230,9 +255,13 @@ impl Scene {
     /// (translation plus rotation at its bounding radius) more than one particle radius per
     /// substep, so that a fast tool is swept rather than teleported; a jump (faster than
     /// [`Scene::tool_jump_speed`]) is not swept. At least `min_substeps`, and at least
-    /// `crushed_substeps` when the crush guard runs and the tissue at a tool is compressed
-    /// ([`Scene::compressed_at_a_tool`]: a function of the state, so a restored state steps the
-    /// same).
+    /// `crushed_substeps` when the crush guard runs and the tissue at a tool is compressed; and
+    /// twice that (before `crushed_substeps`) when a compressed tetrahedron there is longer than
+    /// the tool is wide ([`Scene::crushed_at_tools`]: a function of the state, so a restored
+    /// state steps the same). A tool narrower than the tetrahedra it crushes presses on a corner
+    /// or an edge of the mesh: in one substep the contact and the crush guard fought over those
+    /// corners until the tetrahedra inverted and the tool slipped into the tissue
+    /// (docs/VALIDATION.md §5); half the substep holds it.
     pub(crate) fn substeps_needed(&self) -> (u32, bool) {
         let s = &self.settings;
         let mut h_max = Real::INFINITY;
@@ -255,8 +284,14 @@ impl Scene {
             }
         }
         let mut n = needed.max(s.min_substeps);
-        if n < s.crushed_substeps && self.crush_guard_on() && self.compressed_at_a_tool() {
-            n = s.crushed_substeps;
+        if self.crush_guard_on() {
+            let crushed = self.crushed_at_tools();
+            if crushed.by_a_thinner_tool {
+                n *= 2;
+            }
+            if crushed.any {
+                n = n.max(s.crushed_substeps);
+            }
         }
         if n > s.max_substeps {
             (s.max_substeps, true)

@@ -74,11 +74,13 @@ pub struct Settings {
     /// below half its rest volume, now or two steps ahead at its corners' velocities. Applies
     /// with the elasticity on tetrahedra and the volume constraints on (where the crush guard
     /// runs).
-    /// 1 (the default) adds none. 2 keeps small probes pressed deep out of the tissue (a 1 mm
-    /// sphere 3 cm into organs of another mesher, a 1 cm probe 20 cm into the default organ)
-    /// at twice the cost of the steps that compress it, which in a deep press is most of them
-    /// (docs/SETTINGS.md, "Deep presses"). The check costs a distance per particle when the
-    /// setting is above 1 and a tool is in the world.
+    /// 1 (the default) adds none; where the tool is narrower than a compressed tetrahedron's
+    /// longest rest edge the step takes twice its substeps whatever this setting (the
+    /// narrower tool presses on a corner or an edge: small probes pressed deep stay out of the
+    /// tissue). 2 keeps wide probes pressed deep out too (a 1 cm probe 20 cm into the default
+    /// organ) at twice the cost of the steps that compress the tissue, which in a deep press
+    /// is most of them (docs/SETTINGS.md, "Deep presses"). The check costs a distance per
+    /// particle each step while a tool is in the world.
     pub crushed_substeps: u32,
     /// Largest number of substeps per step; a step that needs more is reported
     /// (`StepReport::substeps_clamped`) and runs with this many.

@@ -51,6 +51,19 @@ pub enum ToolShape {
 pub const CONVEX_HULL_FLATNESS: Real = 1e-9;
 
 impl ToolShape {
+    /// The width (m) of the shape's narrowest part that presses into tissue: a sphere's,
+    /// capsule's or cylinder's diameter, a box's smallest edge; `None` for a convex hull or a
+    /// triangle mesh, whose narrowest width is not at hand (they count as wide).
+    pub(crate) fn width(&self) -> Option<Real> {
+        match self {
+            ToolShape::Sphere { radius }
+            | ToolShape::Capsule { radius, .. }
+            | ToolShape::Cylinder { radius, .. } => Some(2.0 * radius),
+            ToolShape::Cuboid { half_extents } => Some(2.0 * half_extents.min()),
+            ToolShape::ConvexHull { .. } | ToolShape::TriMesh { .. } => None,
+        }
+    }
+
     /// Check the shape: NaN or ±Inf give [`Error::NonFinite`]; otherwise radii, cylinder
     /// half-heights and box half-extents must be > 0 m, a capsule's half-height ≥ 0 m (0 is a
     /// sphere), a convex hull needs at least 4 points not all in one plane (within
