@@ -1629,10 +1629,11 @@ enum ts_status ts_world_schemes(const struct ts_world *world, struct ts_schemes 
  * settings) in a step that starts with the tissue at a tool compressed: a tetrahedron with a
  * corner within a particle radius of a tool's bounding box below half its rest volume, now or
  * two steps ahead (the elasticity on tetrahedra, the volume constraints on). 1, the default,
- * adds none;
- * 2 keeps small probes pressed deep out of the tissue at twice the cost of the steps that
- * compress it (docs/SETTINGS.md, "Deep presses"). 0 or more than max_substeps returns
- * TS_STATUS_INVALID_ARGUMENT and changes nothing.
+ * adds none (where the tool is narrower than a compressed tetrahedron's longest rest edge the
+ * step takes twice its substeps whatever this setting); 2 keeps wide probes pressed deep out
+ * of the tissue too, at twice the cost of the steps that compress it (docs/SETTINGS.md,
+ * "Deep presses"). 0 or more than max_substeps returns TS_STATUS_INVALID_ARGUMENT and changes
+ * nothing.
  *
  * # Safety
  *

@@ -155,8 +155,9 @@ pub struct Settings {
     /// Smallest number of substeps per step (>= 1). Default 1.
     pub min_substeps: u32,
     /// Smallest number of substeps of a step that starts with the tissue at a tool compressed
-    /// (a tetrahedron touching it below half its rest volume). Default 1 (none added); 2 for
-    /// deep presses.
+    /// (a tetrahedron touching it below half its rest volume). Default 1 (none added by the
+    /// setting; a tool narrower than the compressed tetrahedron doubles the step's substeps
+    /// anyway); 2 for deep presses with wide probes.
     pub crushed_substeps: u32,
     /// Largest number of substeps per step; a step needing more is clamped. Default 64.
     pub max_substeps: u32,

@@ -1,6 +1,6 @@
 //! The substeps of a step that starts with the tissue at a tool compressed, from C (the Rust
 //! `Settings::crushed_substeps`). Not a field of ts_settings, whose layout is fixed: a world
-//! starts with 1 (no extra substeps), ts_world_set_crushed_substeps changes it, and
+//! starts with 1 (none added by the setting), ts_world_set_crushed_substeps changes it, and
 //! ts_world_set_settings keeps it.
 
 use crate::ffi::args::world_mut;
@@ -13,10 +13,11 @@ use crate::Settings;
 /// settings) in a step that starts with the tissue at a tool compressed: a tetrahedron with a
 /// corner within a particle radius of a tool's bounding box below half its rest volume, now or
 /// two steps ahead (the elasticity on tetrahedra, the volume constraints on). 1, the default,
-/// adds none;
-/// 2 keeps small probes pressed deep out of the tissue at twice the cost of the steps that
-/// compress it (docs/SETTINGS.md, "Deep presses"). 0 or more than max_substeps returns
-/// TS_STATUS_INVALID_ARGUMENT and changes nothing.
+/// adds none (where the tool is narrower than a compressed tetrahedron's longest rest edge the
+/// step takes twice its substeps whatever this setting); 2 keeps wide probes pressed deep out
+/// of the tissue too, at twice the cost of the steps that compress it (docs/SETTINGS.md,
+/// "Deep presses"). 0 or more than max_substeps returns TS_STATUS_INVALID_ARGUMENT and changes
+/// nothing.
 ///
 /// # Safety
 ///
