@@ -212,17 +212,23 @@ impl Scene {
     /// particle radius of a tool's bounding box (not a blade's; at the tool's pose) is below
     /// [`COMPRESSED_RATIO`] of its rest volume at the start of the step, or will be
     /// [`CRUSH_LOOKAHEAD_STEPS`] steps later at its corners' velocities; and whether such a
-    /// tetrahedron is longer (its longest rest edge) than the tool is wide
-    /// ([`ToolShape::width`](crate::ToolShape)). Reads the state only (positions, velocities,
-    /// tool poses). Cost: a distance per particle and tool, a point in a box for those within
-    /// the tool's bounding sphere, and the tetrahedra around those in the box.
-    fn crushed_at_tools(&self) -> CrushedAtTools {
+    /// tetrahedron is longer (its longest rest edge) than the tool is wide. Reads the state only (positions, velocities,
+    /// tool poses). Only `thin_only`: the tools without a width ([`ToolShape::width`]) are not
+    /// looked at (they can only set `any`). Cost: a distance per particle and tool, a point in
+    /// a box for those within the tool's bounding sphere, and the tetrahedra around those in
+    /// the box.
+    ///
+    /// [`ToolShape::width`]: crate::ToolShape
+    fn crushed_at_tools(&self, thin_only: bool) -> CrushedAtTools {
         let mut found = CrushedAtTools::default();
         let tools = self.tools.iter().flatten().filter(|slot| !slot.blade);
         let ahead = CRUSH_LOOKAHEAD_STEPS * self.settings.dt;
         for tool in tools.map(|slot| &slot.tool) {
-            let (iso, local_box) = (tool.pose.isometry(), tool.shape.compute_local_aabb());
             let width = tool.description.width();
+            if thin_only && width.is_none() {
+                continue;
+            }
+            let (iso, local_box) = (tool.pose.isometry(), tool.shape.compute_local_aabb());
             for body in &self.bodies {
                 let reach = body.model.particle_radius;
                 let (near, within) = (tool.bounding_radius + reach, local_box.loosened(reach));
@@ -285,7 +291,8 @@ impl Scene {
         }
         let mut n = needed.max(s.min_substeps);
         if self.crush_guard_on() {
-            let crushed = self.crushed_at_tools();
+            // Where `crushed_substeps` cannot add a substep only a narrower tool matters.
+            let crushed = self.crushed_at_tools(n >= s.crushed_substeps);
             if crushed.by_a_thinner_tool {
                 n *= 2;
             }
