@@ -80,7 +80,8 @@ pub struct Settings {
     /// tissue). 2 keeps wide probes pressed deep out too (a 1 cm probe 20 cm into the default
     /// organ) at twice the cost of the steps that compress the tissue, which in a deep press
     /// is most of them (docs/SETTINGS.md, "Deep presses"). The check costs a distance per
-    /// particle each step while a tool is in the world.
+    /// particle each step while a sphere, capsule, cylinder or box tool is in the world (any
+    /// tool when the setting is above 1).
     pub crushed_substeps: u32,
     /// Largest number of substeps per step; a step that needs more is reported
     /// (`StepReport::substeps_clamped`) and runs with this many.
