@@ -1,0 +1,359 @@
+//! The contact goal's deep presses on any organ mesh (docs/VALIDATION.md §5): the organ hung by
+//! its top 15% and settled, a probe pressed horizontally through the middle of its rest bounding
+//! box at 5 cm/s from 2 mm off the surface, `--depth` past first contact, held, and withdrawn,
+//! from each side. Measured every step against the deformed boundary surface, independently of
+//! the library's own contact report:
+//! - the probe's centre inside the organ (generalised winding number, `Body::contains`);
+//! - the depth of the surface inside the probe: the radius less the distance from the centre to
+//!   the nearest boundary triangle;
+//! - the contact steps whose force on the probe has a component along the press (pulling);
+//! - the tissue: the most tetrahedra inverted at once, the fastest particle (m/s), and the steps
+//!   that diverged (rolled back by the library; the press goes on).
+//!
+//! A press meets the goal when the centre is never inside, the surface never more than a fifth
+//! of the radius inside the probe, no contact step pulls and no step diverges. A press whose probe touched the
+//! organ on less than 40% of its pressing steps (the press line grazes or misses the organ) is
+//! reported and not judged.
+//!
+//! ```text
+//! cargo run --release --example press_check -- [--radii 1,2.5,5,10] [--sides +x,-x,+z,-z]
+//!     [--depth 0.03] [--hold 0.5] [--scale 0.03] [--crushed-substeps N] MESH...
+//! ```
+//! `MESH`: a mesh file (TetGen `.node`/`.ele` base, gmsh `.msh`, legacy `.vtk`) or the name of
+//! one in `data/meshes`; `--scale` its unit in metres (0.03: the data meshes' organs, 12–21 cm
+//! across); `--radii` the sphere radii (mm); `--depth` metres past first contact; `--hold`
+//! seconds. Exits non-zero when a judged press misses the goal.
+
+use parry3d_f64::math::{Point, Vector};
+use parry3d_f64::query::{PointQuery, Ray, RayCast};
+use parry3d_f64::shape::Triangle;
+use std::path::{Path, PathBuf};
+use tissuesim::{mesh, Body, BodyOptions, Pose, Real, Settings, ToolOptions, ToolShape, Vec3};
+use tissuesim::{Error, World, WorldState};
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Probe speed along the press (m/s).
+const SPEED: Real = 0.05;
+/// Gap (m) between the probe and the surface (plus the contact skin) at the start.
+const GAP: Real = 0.002;
+/// Fraction of the organ's height, from its top, held fixed.
+const FIXED_TOP: Real = 0.15;
+/// Most of the probe's radius the surface may get inside it (the contact goal).
+const MOST_INSIDE: Real = 0.2;
+/// Least share of the pressing steps in contact for a press to be judged.
+const LEAST_CONTACT: Real = 0.4;
+
+/// What one press measured.
+struct Press {
+    /// Largest depth (m) of the surface inside the probe; negative: it stayed outside.
+    deepest: Real,
+    /// Steps with the probe's centre inside the deformed surface.
+    centre_inside: usize,
+    /// Contact steps of the press and hold whose force pulled the probe along the press.
+    pulling: usize,
+    /// Largest force (N) along the press on a pulling step.
+    strongest_pull: Real,
+    /// Steps of the press and hold in contact, of `pressing_steps`.
+    contact_steps: usize,
+    pressing_steps: usize,
+    /// Most tetrahedra inverted at once.
+    inverted: usize,
+    /// Fastest particle (m/s).
+    fastest: Real,
+    /// Steps that diverged and were rolled back (the tool moves on).
+    rolled_back: usize,
+}
+
+/// The settled hanging organ that every press starts from.
+struct Hanging {
+    /// The body's model, shared by every press's world.
+    model: std::sync::Arc<tissuesim::BodyModel>,
+    /// The world's state once settled.
+    state: WorldState,
+    /// The rest positions (m), whose bounding box's middle the presses go through.
+    rest: Vec<Vec3>,
+}
+
+/// The mesh at `name`: a file, or a name in `data/meshes`.
+fn mesh_path(name: &str) -> PathBuf {
+    let given = PathBuf::from(name);
+    let node = given.with_extension("node");
+    if given.is_file() || node.is_file() {
+        return given;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/meshes")
+        .join(name)
+}
+
+/// Load `name` at `scale` (m per mesh unit), centre it, hang it by its top and settle it.
+fn hang(name: &str, scale: Real, settings: &Settings) -> Res<Hanging> {
+    let (mut organ, _) = mesh::load(&mesh_path(name), scale)?;
+    let (lo, hi) = organ.bounding_box();
+    let centre = (lo + hi) * 0.5;
+    organ.nodes.iter_mut().for_each(|p| *p -= centre);
+    let mut world = World::new(settings.clone())?;
+    let body = world.add_body(&organ, &BodyOptions::default())?;
+    let (lo, hi) = (lo - centre, hi - centre);
+    let top = hi.y - FIXED_TOP * (hi.y - lo.y);
+    let margin = 1.0;
+    let fixed = world.fix_box(
+        body,
+        Vec3::new(lo.x - margin, top, lo.z - margin),
+        hi.add_scalar(margin),
+    )?;
+    if fixed == 0 {
+        return Err(format!("{name}: no particle in the top {FIXED_TOP} of the organ").into());
+    }
+    world.settle()?;
+    let b = world.body(body)?;
+    Ok(Hanging {
+        model: b.model().clone(),
+        state: world.state(),
+        rest: b.rest_positions().to_vec(),
+    })
+}
+
+/// The boundary triangles of `body` at its current positions.
+fn surface(body: &Body) -> Vec<Triangle> {
+    let x = body.positions();
+    let point = |k: u32| Point::from(x[k as usize]);
+    let triangles = body.boundary_triangles().iter();
+    triangles
+        .map(|t| Triangle::new(point(t[0]), point(t[1]), point(t[2])))
+        .collect()
+}
+
+/// Distance (m) from `p` to the nearest of `triangles`.
+fn distance(triangles: &[Triangle], p: &Vec3) -> Real {
+    let p = Point::from(*p);
+    let each = triangles
+        .iter()
+        .map(|t| t.distance_to_local_point(&p, true));
+    each.fold(Real::INFINITY, Real::min)
+}
+
+/// Where a probe reaching `reach` (m) starts on the line through `through` along `direction`:
+/// `GAP` plus `skin` before the first boundary triangle the line meets, then moved back until
+/// no part of the surface is nearer than that (a curved surface can bulge towards the probe off
+/// the line). `None` when the line misses the organ.
+fn start(
+    triangles: &[Triangle],
+    (through, direction): (Vec3, Vec3),
+    reach: Real,
+    skin: Real,
+) -> Option<Vec3> {
+    let far = 10.0;
+    let ray = Ray::new(
+        Point::from(through - direction * far),
+        Vector::from(direction),
+    );
+    let hit = triangles
+        .iter()
+        .filter_map(|t| t.cast_local_ray(&ray, 2.0 * far, false))
+        .fold(Real::INFINITY, Real::min);
+    if !hit.is_finite() {
+        return None;
+    }
+    let clearance = reach + skin + GAP;
+    let mut centre = through + direction * (hit - far - clearance);
+    for _ in 0..100 {
+        if distance(triangles, &centre) >= clearance {
+            break;
+        }
+        centre -= direction * 0.001;
+    }
+    Some(centre)
+}
+
+/// Signed volume (m³) of tetrahedron `t` at positions `x`.
+fn volume(x: &[Vec3], t: &[u32; 4]) -> Real {
+    let [a, b, c, d] = t.map(|k| x[k as usize]);
+    (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
+}
+
+/// One press of a sphere of `radius` (m) from `start` along `direction`.
+fn press(
+    organ: &Hanging,
+    settings: &Settings,
+    radius: Real,
+    (start, direction): (Vec3, Vec3),
+    (depth, hold): (Real, Real),
+) -> Res<Press> {
+    let mut world = World::new(settings.clone())?;
+    let body = world.add_body_model(organ.model.clone());
+    world.set_state(&organ.state)?;
+    let probe = ToolShape::Sphere { radius };
+    let tool = world.add_tool(probe, Pose::at(start), &ToolOptions::default())?;
+    let dt = world.settings().dt;
+    let press_steps = ((GAP + depth) / SPEED / dt).round() as usize;
+    let hold_steps = (hold / dt).round() as usize;
+    let total = 2 * press_steps + hold_steps;
+    let tets = world.body(body)?.tets().to_vec();
+    let mut p = Press {
+        deepest: Real::NEG_INFINITY,
+        centre_inside: 0,
+        pulling: 0,
+        strongest_pull: 0.0,
+        contact_steps: 0,
+        pressing_steps: press_steps + hold_steps,
+        inverted: 0,
+        fastest: 0.0,
+        rolled_back: 0,
+    };
+    for k in 1..=total {
+        let along = k.min(press_steps).min(total - k) as Real;
+        let centre = start + direction * (SPEED * dt * along);
+        world.set_tool_pose(tool, Pose::at(centre))?;
+        match world.step() {
+            Ok(_) => {}
+            Err(Error::Diverged(_)) => p.rolled_back += 1,
+            Err(e) => return Err(e.into()),
+        }
+        let b = world.body(body)?;
+        p.deepest = p.deepest.max(radius - distance(&surface(b), &centre));
+        p.centre_inside += b.contains(&centre) as usize;
+        let inverted = tets.iter().filter(|t| volume(b.positions(), t) < 0.0);
+        p.inverted = p.inverted.max(inverted.count());
+        let speeds = b.velocities().iter().map(|v| v.norm());
+        p.fastest = speeds.fold(p.fastest, Real::max);
+        let wrench = world.tool(tool)?.wrench();
+        if wrench.contact_count > 0 && k <= press_steps + hold_steps {
+            p.contact_steps += 1;
+            let along = wrench.force.dot(&direction);
+            p.pulling += (along > 0.0) as usize;
+            p.strongest_pull = p.strongest_pull.max(along);
+        }
+    }
+    Ok(p)
+}
+
+/// The value after `flag` in `args`, parsed, or `default`.
+fn option<T: std::str::FromStr>(args: &[String], flag: &str, default: T) -> Res<T>
+where
+    T::Err: std::error::Error + 'static,
+{
+    match args.iter().position(|a| a == flag) {
+        Some(i) => Ok(args
+            .get(i + 1)
+            .ok_or(format!("{flag} needs a value"))?
+            .parse()?),
+        None => Ok(default),
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("press_check: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// Parse the arguments, run every press and report them.
+fn run() -> Res<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let radii: String = option(&args, "--radii", "1,2.5,5,10".to_string())?;
+    let sides: String = option(&args, "--sides", "+x,-x,+z,-z".to_string())?;
+    let depth: Real = option(&args, "--depth", 0.03)?;
+    let hold: Real = option(&args, "--hold", 0.5)?;
+    let scale: Real = option(&args, "--scale", 0.03)?;
+    let mut settings = Settings::default();
+    settings.crushed_substeps = option(&args, "--crushed-substeps", settings.crushed_substeps)?;
+    let valued = [
+        "--radii",
+        "--sides",
+        "--depth",
+        "--hold",
+        "--scale",
+        "--crushed-substeps",
+    ];
+    let meshes: Vec<&String> = (args.iter().enumerate())
+        .filter(|&(i, a)| {
+            !a.starts_with("--") && (i == 0 || !valued.contains(&args[i - 1].as_str()))
+        })
+        .map(|(_, a)| a)
+        .collect();
+    if meshes.is_empty() {
+        return Err("give at least one mesh (a file or a name in data/meshes)".into());
+    }
+    let radii: Vec<Real> = (radii.split(','))
+        .map(|r| r.trim().parse::<Real>().map(|mm| mm * 1e-3))
+        .collect::<Result<_, _>>()?;
+    let (mut judged, mut missed) = (0, Vec::new());
+    println!("mesh | radius mm | side | centre inside | deepest / radius | pulling steps (strongest, N) | contact | most inverted | fastest m/s | rolled back | goal");
+    for name in meshes {
+        let organ = hang(name, scale, &settings)?;
+        let (lo, hi) = organ.rest.iter().fold(
+            (Vec3::repeat(Real::MAX), Vec3::repeat(Real::MIN)),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let middle = (lo + hi) * 0.5;
+        let mut world = World::new(settings.clone())?;
+        let body = world.add_body_model(organ.model.clone());
+        world.set_state(&organ.state)?;
+        let (triangles, skin) = (surface(world.body(body)?), world.body(body)?.contact_skin());
+        for side in sides.split(',').map(str::trim) {
+            let (direction, through) = match side {
+                "+x" | "-x" => (Vec3::x(), Vec3::new(0.0, middle.y, middle.z)),
+                "+z" | "-z" => (Vec3::z(), Vec3::new(middle.x, middle.y, 0.0)),
+                s => return Err(format!("unknown side {s} (+x, -x, +z, -z)").into()),
+            };
+            let direction = if side.starts_with('-') {
+                -direction
+            } else {
+                direction
+            };
+            for &radius in &radii {
+                let Some(from) = start(&triangles, (through, direction), radius, skin) else {
+                    println!(
+                        "{name} | {} | {side} | the press line misses the organ",
+                        radius * 1e3
+                    );
+                    continue;
+                };
+                let p = press(&organ, &settings, radius, (from, direction), (depth, hold))?;
+                let touched = p.contact_steps as Real >= LEAST_CONTACT * p.pressing_steps as Real;
+                let meets = p.centre_inside == 0
+                    && p.deepest <= MOST_INSIDE * radius
+                    && p.pulling == 0
+                    && p.rolled_back == 0;
+                let verdict = match (touched, meets) {
+                    (false, _) => "not judged (grazes the organ)",
+                    (true, true) => "meets",
+                    (true, false) => "misses",
+                };
+                println!(
+                    "{name} | {} | {side} | {} | {:.2} | {} ({:.3}) | {} of {} | {} | {:.2} | {} | {verdict}",
+                    radius * 1e3,
+                    p.centre_inside,
+                    p.deepest / radius,
+                    p.pulling,
+                    p.strongest_pull,
+                    p.contact_steps,
+                    p.pressing_steps,
+                    p.inverted,
+                    p.fastest,
+                    p.rolled_back
+                );
+                if touched {
+                    judged += 1;
+                    if !meets {
+                        missed.push(format!("{name} {} mm {side}", radius * 1e3));
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "{} of {judged} judged presses meet the goal",
+        judged - missed.len()
+    );
+    if !missed.is_empty() {
+        return Err(format!("missed the goal: {}", missed.join(", ")).into());
+    }
+    Ok(())
+}
