@@ -28,8 +28,9 @@ use parry3d_f64::math::{Point, Vector};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::Triangle;
 use std::path::{Path, PathBuf};
-use tissuesim::{mesh, Body, BodyOptions, Pose, Real, Settings, ToolOptions, ToolShape, Vec3};
+use tissuesim::{mesh, tet_volume, Body, BodyOptions, Pose, Real, Settings, ToolOptions};
 use tissuesim::{Error, World, WorldState};
+use tissuesim::{ToolShape, Vec3};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
@@ -71,8 +72,8 @@ struct Hanging {
     model: std::sync::Arc<tissuesim::BodyModel>,
     /// The world's state once settled.
     state: WorldState,
-    /// The rest positions (m), whose bounding box's middle the presses go through.
-    rest: Vec<Vec3>,
+    /// The middle (m) of the rest bounding box, which the presses go through.
+    middle: Vec3,
 }
 
 /// The mesh at `name`: a file, or a name in `data/meshes`.
@@ -111,7 +112,14 @@ fn hang(name: &str, scale: Real, settings: &Settings) -> Res<Hanging> {
     Ok(Hanging {
         model: b.model().clone(),
         state: world.state(),
-        rest: b.rest_positions().to_vec(),
+        middle: {
+            let rest = b.rest_positions().iter();
+            let (lo, hi) = rest.fold(
+                (Vec3::repeat(Real::MAX), -Vec3::repeat(Real::MAX)),
+                |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+            );
+            (lo + hi) * 0.5
+        },
     })
 }
 
@@ -167,12 +175,6 @@ fn start(
     Some(centre)
 }
 
-/// Signed volume (m³) of tetrahedron `t` at positions `x`.
-fn volume(x: &[Vec3], t: &[u32; 4]) -> Real {
-    let [a, b, c, d] = t.map(|k| x[k as usize]);
-    (b - a).cross(&(c - a)).dot(&(d - a)) / 6.0
-}
-
 /// One press of a sphere of `radius` (m) from `start` along `direction`.
 fn press(
     organ: &Hanging,
@@ -214,7 +216,10 @@ fn press(
         let b = world.body(body)?;
         p.deepest = p.deepest.max(radius - distance(&surface(b), &centre));
         p.centre_inside += b.contains(&centre) as usize;
-        let inverted = tets.iter().filter(|t| volume(b.positions(), t) < 0.0);
+        let x = b.positions();
+        let corners = |t: &[u32; 4]| t.map(|k| x[k as usize]);
+        let inverted =
+            (tets.iter().map(corners)).filter(|[p, q, r, s]| tet_volume(p, q, r, s) < 0.0);
         p.inverted = p.inverted.max(inverted.count());
         let speeds = b.velocities().iter().map(|v| v.norm());
         p.fastest = speeds.fold(p.fastest, Real::max);
@@ -287,11 +292,7 @@ fn run() -> Res<()> {
     println!("mesh | radius mm | side | centre inside | deepest / radius | pulling steps (strongest, N) | contact | most inverted | fastest m/s | rolled back | goal");
     for name in meshes {
         let organ = hang(name, scale, &settings)?;
-        let (lo, hi) = organ.rest.iter().fold(
-            (Vec3::repeat(Real::MAX), Vec3::repeat(Real::MIN)),
-            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-        );
-        let middle = (lo + hi) * 0.5;
+        let middle = organ.middle;
         let mut world = World::new(settings.clone())?;
         let body = world.add_body_model(organ.model.clone());
         world.set_state(&organ.state)?;
