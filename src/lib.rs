@@ -64,6 +64,7 @@ pub use model::particle_order::ParticleOrder;
 pub use needle::{NeedleOptions, NeedleState};
 pub use scene::body::{Body, STATE_POSITION_LIMIT, STATE_SPEED_LIMIT};
 pub use scene::settings::{ContactMode, DivergenceLimits, ElasticScheme, Settings, VolumeScheme};
+pub use scene::substep_hold::SUBSTEP_HOLD_STEPS;
 pub use scene::tool::{
     Pose, Tool, ToolOptions, ToolShape, Wrench, CONVEX_HULL_FLATNESS, MIN_QUATERNION_NORM,
     TOOL_SIZE_RANGE,

@@ -182,19 +182,25 @@ fn restore_refuses_far_positions_and_huge_velocities() {
     w.add_body(&cube(), &BodyOptions::default()).unwrap();
     let mut good = Vec::new();
     w.save_state(&mut good);
-    let header = 8 + 4 + 4 + 4 + 8 + 4;
+    // Magic, version, counts, time; the substep hold; the first body's particle count.
+    let hold = 8 + 4 + 4 + 4 + 8;
+    let header = hold + 4 + 4 + 4;
     let n = w.body(tissuesim::BodyId(0)).unwrap().particle_count();
-    for (offset, what) in [(0, "position"), (n * 24, "velocity")] {
+    let crafted = [
+        (header, 1e300f64.to_le_bytes().to_vec(), "position"),
+        (header + n * 24, 1e300f64.to_le_bytes().to_vec(), "velocity"),
+        (hold + 4, 1000u32.to_le_bytes().to_vec(), "substep hold"),
+    ];
+    for (at, value, what) in crafted {
         let mut bad = good.clone();
-        let at = header + offset;
-        bad[at..at + 8].copy_from_slice(&1e300f64.to_le_bytes());
+        bad[at..at + value.len()].copy_from_slice(&value);
         // Re-seal the checksum: a crafted state, not a corrupt one.
         let body = bad.len() - 8;
         let sum = fnv1a(&bad[..body]);
         bad[body..].copy_from_slice(&sum.to_le_bytes());
         match w.restore_state(&bad) {
             Err(Error::BadState(m)) => assert!(m.contains(what), "{m}"),
-            other => panic!("crafted {what} 1e300 restored: {other:?}"),
+            other => panic!("crafted {what} restored: {other:?}"),
         }
     }
     w.restore_state(&good).unwrap();

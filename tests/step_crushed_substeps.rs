@@ -3,12 +3,15 @@
 //! least that many substeps. By default, whatever that setting: such a step takes twice the
 //! substeps it would otherwise when the compressed tetrahedron is longer (its longest rest edge)
 //! than the tool is wide. Otherwise the step substeps as before. The rules read the state at the
-//! start of the step only (positions, the tools' poses), so a restored state steps the same.
+//! start of the step only (positions, the tools' poses). A count they raised is held for
+//! `SUBSTEP_HOLD_STEPS` steps after they ask for less; the hold is part of the saved state, so
+//! a restored state steps the same.
 
 mod common;
 
 use tissuesim::{
     mesh, BodyId, BodyOptions, Error, Pose, Real, Settings, ToolOptions, ToolShape, Vec3, World,
+    SUBSTEP_HOLD_STEPS,
 };
 
 /// The radius (m) of the probe resting on the box.
@@ -138,6 +141,47 @@ fn a_probe_narrower_than_the_crushed_tetrahedra_doubles_the_substeps() {
     let (mut world, _) = flattened_box(crushed(1), 0.4);
     sphere_on_top(&mut world, PROBE, 0.4, 0.0);
     assert_eq!(world.step().unwrap().substeps, 2);
+}
+
+/// The narrow probe of the test above lifted off after one step: the rules ask for two
+/// substeps on the step that lifts it (it starts on the box) and for one after, but the steps
+/// take two for `SUBSTEP_HOLD_STEPS` steps more, then one. A state saved
+/// inside the hold and restored into a world built the same way takes the same substeps and
+/// ends at the same positions, bit for bit.
+#[test]
+fn a_raised_count_is_held_after_the_tool_leaves_and_saved_with_the_state() {
+    let build = || {
+        let (mut world, body) = flattened_box(crushed(1), 0.4);
+        sphere_on_top(&mut world, PROBE, 0.4, 0.0);
+        (world, body)
+    };
+    let (mut world, body) = build();
+    assert_eq!(world.step().unwrap().substeps, 2);
+    let probe = world.tool_ids().next().unwrap();
+    let away = Pose::at(Vec3::new(0.03, 1.0, 0.03));
+    world.set_tool_pose(probe, away).unwrap();
+    let mut saved = Vec::new();
+    world.save_state(&mut saved);
+    let run = |w: &mut World| -> Vec<u32> {
+        (0..SUBSTEP_HOLD_STEPS + 4)
+            .map(|_| {
+                let needed = w.substeps_needed().0;
+                let taken = w.step().unwrap().substeps;
+                assert_eq!(needed, taken, "substeps_needed and the step disagree");
+                taken
+            })
+            .collect()
+    };
+    let taken = run(&mut world);
+    let held = taken.iter().take_while(|&&n| n == 2).count();
+    assert_eq!(held, 1 + SUBSTEP_HOLD_STEPS as usize, "{taken:?}");
+    assert!(taken[held..].iter().all(|&n| n == 1), "{taken:?}");
+
+    let (mut restored, _) = build();
+    restored.restore_state(&saved).unwrap();
+    assert_eq!(run(&mut restored), taken);
+    let x = |w: &World| w.body(body).unwrap().positions().to_vec();
+    assert_eq!(x(&restored), x(&world), "the restored run differs");
 }
 
 #[test]

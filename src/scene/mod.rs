@@ -22,6 +22,7 @@ pub(crate) mod needle_state;
 pub(crate) mod particles;
 pub(crate) mod settings;
 pub(crate) mod state;
+pub(crate) mod substep_hold;
 pub(crate) mod tool;
 
 pub use state::WorldState;
@@ -34,6 +35,7 @@ use crate::scene::cut::CutReport;
 use crate::scene::grasp_state::Grasp;
 use crate::scene::needle_state::Needle;
 use crate::scene::settings::{ElasticScheme, Settings};
+use crate::scene::substep_hold::SubstepHold;
 use crate::scene::tool::{Tool, ToolLoad};
 use parry3d_f64::bounding_volume::BoundingVolume;
 
@@ -130,6 +132,8 @@ pub(crate) struct Scene {
     pub(crate) pair_friction: Vec<PairFriction>,
     /// Simulated time (s).
     pub(crate) time: Real,
+    /// The substep count held after the rules raised it ([`substep_hold`]).
+    pub(crate) substep_hold: SubstepHold,
 }
 
 impl Scene {
@@ -141,6 +145,7 @@ impl Scene {
             tools: Vec::new(),
             pair_friction: Vec::new(),
             time: 0.0,
+            substep_hold: SubstepHold::default(),
         }
     }
 
@@ -267,8 +272,32 @@ impl Scene {
     /// state steps the same). A tool narrower than the tetrahedra it crushes presses on a corner
     /// or an edge of the mesh: in one substep the contact and the crush guard fought over those
     /// corners until the tetrahedra inverted and the tool slipped into the tissue
-    /// (docs/VALIDATION.md §5); half the substep holds it.
+    /// (docs/VALIDATION.md §5); half the substep holds it. A count these rules raised is held
+    /// for [`substep_hold::SUBSTEP_HOLD_STEPS`] steps after they ask for less ([`substep_hold`]).
     pub(crate) fn substeps_needed(&self) -> (u32, bool) {
+        self.held_substeps(self.substeps_asked())
+    }
+
+    /// Start a step: the substeps it takes ([`Scene::substeps_needed`]), and the hold on the
+    /// count moved on (part of the state, so a rolled-back step puts it back).
+    pub(crate) fn take_substeps(&mut self) -> (u32, bool) {
+        let asked = self.substeps_asked();
+        let (n, clamped) = self.held_substeps(asked);
+        self.substep_hold.advance(asked.0, n);
+        (n, clamped)
+    }
+
+    /// The count of `asked` (from [`Scene::substeps_asked`]) with the hold.
+    fn held_substeps(&self, (asked, clamped): (u32, bool)) -> (u32, bool) {
+        let n = self
+            .substep_hold
+            .count_for(asked)
+            .min(self.settings.max_substeps);
+        (n, clamped && n == asked)
+    }
+
+    /// What the rules of [`Scene::substeps_needed`] ask for, before the hold.
+    fn substeps_asked(&self) -> (u32, bool) {
         let s = &self.settings;
         let mut h_max = Real::INFINITY;
         let mut radius = Real::INFINITY;

@@ -20,11 +20,12 @@ use crate::scene::body::{Body, ParticleState};
 use crate::scene::cut::CutSets;
 use crate::scene::grasp_state::Grasp;
 use crate::scene::needle_state::ShaftHold;
+use crate::scene::substep_hold::{SubstepHold, SUBSTEP_HOLD_STEPS};
 use crate::scene::tool::{Pose, Wrench};
 use crate::scene::Scene;
 use std::sync::Arc;
 
-/// The dynamic state of a world: the time; per body its particles' positions, velocities and
+/// The dynamic state of a world: the time and the substep count held after a raise; per body its particles' positions, velocities and
 /// rotations, its fixed flags and what has been cut; per tool its pose, target pose, velocity,
 /// last wrench, grasp and needle insertion.
 ///
@@ -35,6 +36,8 @@ use std::sync::Arc;
 pub struct WorldState {
     /// Simulated time (s).
     pub(crate) time: Real,
+    /// The substep count held after a raise ([`crate::scene::substep_hold`]).
+    pub(crate) substep_hold: SubstepHold,
     /// One per body, in id order.
     pub(crate) bodies: Vec<BodyState>,
     /// One per tool in the world (removed tools left out), in id order.
@@ -110,6 +113,7 @@ impl Scene {
     /// `pool`'s threads): once `out` has held a state of this scene, this allocates nothing.
     pub(crate) fn state_into(&self, out: &mut WorldState, pool: &Pool) {
         out.time = self.time;
+        out.substep_hold = self.substep_hold;
         out.bodies.truncate(self.bodies.len());
         for (k, body) in self.bodies.iter().enumerate() {
             match out.bodies.get_mut(k) {
@@ -180,6 +184,14 @@ impl Scene {
         if !state.time.is_finite() {
             return Err("non-finite time".into());
         }
+        let hold = state.substep_hold;
+        if hold.steps_left > SUBSTEP_HOLD_STEPS || (hold.steps_left > 0 && hold.count == 0) {
+            return Err(format!(
+                "substep hold of {} substeps for {} steps (at most {SUBSTEP_HOLD_STEPS}, of at \
+                 least one substep)",
+                hold.count, hold.steps_left
+            ));
+        }
         if state.bodies.len() != self.bodies.len() || state.tools.len() != self.tool_count() {
             return Err(format!(
                 "state of {} bodies and {} tools, this world has {} and {}",
@@ -249,6 +261,7 @@ impl Scene {
     /// pipeline's scratch (`Pipeline::fit_boundaries`) before the next step.
     pub(crate) fn apply_state(&mut self, state: &WorldState) {
         self.time = state.time;
+        self.substep_hold = state.substep_hold;
         for (body, s) in self.bodies.iter_mut().zip(&state.bodies) {
             crate::scene::cut::restore(body, &s.cuts);
             if body.fixed != s.fixed {

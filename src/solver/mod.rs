@@ -123,9 +123,9 @@ impl Pipeline {
     /// start of the step and [`Error::Diverged`] says which body and why.
     pub(crate) fn step(&mut self, scene: &mut Scene) -> Result<StepReport, Error> {
         let step_start = self.profiler.start();
-        let (n, clamped) = scene.substeps_needed();
         let mut rollback = std::mem::take(&mut self.workspace.rollback);
         scene.state_into(&mut rollback, &self.pool);
+        let (n, clamped) = scene.take_substeps();
         let mut clock = self.profiler.charge(Stage::StateCopy, step_start);
         // A jump is not swept: the tool is placed at its target for the whole step and the
         // tissue it lands in leaves it at `max_depenetration_speed`. A blade does not push; it

@@ -9,6 +9,7 @@
 //! | format version ([`STATE_VERSION`]) | u32 |
 //! | body count, tool count | u32, u32 |
 //! | time (s) | f64 |
+//! | held substep count, steps (dimensionless) it is still held for (`scene::substep_hold`) | u32, u32 |
 //! | per body: particle count, then positions (m), velocities (m/s) as xyz, rotations as wxyz | u32, f64… |
 //! | then its fixed flags, one byte per particle (0 or 1) | u8… |
 //! | then its cut pairs (count, load-time pair slot indices, increasing) and removed tetrahedra (count, load-time indices, increasing) | u32, u32…, u32, u32… |
@@ -20,7 +21,7 @@
 //! Particles are in each body's particle order (the mesh's nodes sorted for locality, a function
 //! of the mesh alone; version 4 introduced it, so older states are refused rather than
 //! restored onto the wrong particles). Cut pairs are indices into the neighbourhoods' pair
-//! slots, padded per particle (version 5). The scene itself (meshes, materials, settings) is not
+//! slots, padded per particle (version 5). Version 6 added the substep hold. The scene itself (meshes, materials, settings) is not
 //! part of the state: a state restores into a world built the same way. Its size depends on the cuts, grasps and needle holds in
 //! force ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
@@ -38,14 +39,15 @@ use crate::scene::body::ParticleState;
 use crate::scene::grasp_state::{Attachment, Grasp};
 use crate::scene::needle_state::ShaftHold;
 use crate::scene::state::{BodyState, NeedleInsertion, ToolState, WorldState};
+use crate::scene::substep_hold::SubstepHold;
 use crate::scene::tool::{Pose, Wrench};
 use std::sync::Arc;
 
 /// Version of the byte format written by [`World::save_state`](crate::World::save_state).
-pub const STATE_VERSION: u32 = 5;
+pub const STATE_VERSION: u32 = 6;
 
 const MAGIC: &[u8; 8] = b"TSIMSTAT";
-const HEADER: usize = 8 + 4 + 4 + 4 + 8;
+const HEADER: usize = 8 + 4 + 4 + 4 + 8 + 4 + 4;
 /// Bytes of one particle: position, velocity, rotation, fixed flag.
 const PARTICLE_BYTES: usize = 10 * 8 + 1;
 /// Bytes of a tool's fixed part: poses, velocity, wrench, then the grasp's slip force and
@@ -172,6 +174,8 @@ impl WorldState {
         w.u32(self.bodies.len() as u32);
         w.u32(self.tools.len() as u32);
         w.f64(self.time);
+        w.u32(self.substep_hold.count);
+        w.u32(self.substep_hold.steps_left);
         for b in &self.bodies {
             let p = &b.particles;
             w.u32(p.x.len() as u32);
@@ -249,6 +253,10 @@ impl WorldState {
         let body_count = r.count(4 + 8, "bodies")?;
         let tool_count = r.count(TOOL_BYTES, "tools")?;
         let time = r.f64()?;
+        let substep_hold = SubstepHold {
+            count: r.u32()?,
+            steps_left: r.u32()?,
+        };
         let mut bodies = Vec::with_capacity(body_count);
         for _ in 0..body_count {
             let n = r.count(PARTICLE_BYTES, "particles")?;
@@ -326,6 +334,7 @@ impl WorldState {
         }
         Ok(WorldState {
             time,
+            substep_hold,
             bodies,
             tools,
         })
