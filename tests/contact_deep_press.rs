@@ -292,7 +292,7 @@ fn deep_press_settings() -> Settings {
 /// (measured: its centre never inside, the surface 0.60 mm outside it; 598–736 of the 816 steps
 /// take two substeps). Not asserted: the organ swings off the probe for up to 75 of the 404
 /// pressing steps, and up to 63 contact steps have a forward component as the swinging tissue
-/// drags on the probe. With the default settings the probe ends inside on 116, 0, 65 and 0
+/// drags on the probe. With the default settings the probe ends inside on 0, 0, 60 and 275
 /// of the 816 steps (+x, −x, +z, −z; docs/VALIDATION.md).
 #[test]
 fn a_one_centimetre_probe_pressed_20_cm_stays_outside_with_the_deep_press_settings() {
