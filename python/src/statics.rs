@@ -69,5 +69,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CONVEX_HULL_FLATNESS", tissuesim::CONVEX_HULL_FLATNESS)?;
     m.add("MAX_NEIGHBOURS", tissuesim::MAX_NEIGHBOURS)?;
     m.add("TOOL_JUMP_FRACTION", tissuesim::TOOL_JUMP_FRACTION)?;
+    m.add("SUBSTEP_HOLD_STEPS", tissuesim::SUBSTEP_HOLD_STEPS)?;
     Ok(())
 }

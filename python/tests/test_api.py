@@ -345,6 +345,36 @@ def test_the_constants_are_the_libraries():
     assert ts.statics.SETTLE_SPEED > 0
 
 
+def test_a_raised_substep_count_is_held_and_saved_with_the_state():
+    """A 5 mm sphere on a 6 cm box flattened to 0.4 of its height (tetrahedra longer than the
+    probe is wide, below half their volume): two substeps. Lifted away, the steps keep two for
+    SUBSTEP_HOLD_STEPS more, then one; a state saved in the hold replays the same."""
+
+    def build():
+        world = ts.World(ts.Settings(gravity=[0.0, 0.0, 0.0]))
+        b = world.add_body(ts.mesh.lattice_box([0, 0, 0], [0.06, 0.06, 0.06], [6, 6, 6]))
+        x = world.body(b).rest_positions() * [1.0, 0.4, 1.0]
+        world.set_body_state(b, x, np.zeros_like(x))
+        tool = world.add_tool(ts.ToolShape.Sphere(0.005), [0.03, 0.024 + 0.005, 0.03])
+        return world, b, tool
+
+    world, b, tool = build()
+    assert world.step().substeps == 2
+    world.set_tool_pose(tool, [0.03, 1.0, 0.03])
+    saved = world.save_state()
+
+    def run(w):
+        return [w.step().substeps for _ in range(ts.SUBSTEP_HOLD_STEPS + 4)]
+
+    taken = run(world)
+    held = 1 + ts.SUBSTEP_HOLD_STEPS
+    assert taken[:held] == [2] * held and taken[held:] == [1] * 3, taken
+    restored, _, _ = build()
+    restored.restore_state(saved)
+    assert run(restored) == taken
+    np.testing.assert_array_equal(restored.body(b).positions(), world.body(b).positions())
+
+
 def test_hostile_inputs_raise_python_errors_never_a_panic():
     """NaN, infinities, huge and negative numbers, wrong types and shapes everywhere: each
     call either works or raises an ordinary exception (a Rust panic would surface as

@@ -41,6 +41,8 @@ MAX_NEIGHBOURS: Final[int]
 """Most neighbours a particle may have."""
 TOOL_JUMP_FRACTION: Final[float]
 """Fraction of the divergence speed bound above which a tool motion is a jump."""
+SUBSTEP_HOLD_STEPS: Final[int]
+"""Steps a raised substep count is kept after the rules ask for less."""
 SETTLE_TOLERANCE: Final[float]
 """Relative residual at which settle's Newton iterations stop."""
 SETTLE_MAX_ITERATIONS: Final[int]
