@@ -438,7 +438,8 @@ impl World {
     fn tool_jump_speed(&self) -> Real {
         self.inner.tool_jump_speed()
     }
-    /// Substeps the next step needs, and whether `max_substeps` clamped them.
+    /// Substeps the next step needs, and whether `max_substeps` clamped them (a raised count is
+    /// kept for `SUBSTEP_HOLD_STEPS` steps).
     fn substeps_needed(&self) -> (u32, bool) {
         self.inner.substeps_needed()
     }

@@ -767,7 +767,9 @@ class World:
     ) -> None: ...
     def tool_jump_speed(self) -> float:
         """Fastest swept tool motion (m/s); faster is a jump."""
-    def substeps_needed(self) -> tuple[int, bool]: ...
+    def substeps_needed(self) -> tuple[int, bool]:
+        """Substeps the next step takes and whether ``max_substeps`` clamped them (a raised count
+        is kept for ``SUBSTEP_HOLD_STEPS`` steps)."""
     def step(self) -> StepReport:
         """Advance by ``dt`` (GIL released); ``DivergedError`` when rolled back."""
     def settle(self) -> SettleReport:

@@ -25,9 +25,9 @@ use crate::scene::tool::{Pose, Wrench};
 use crate::scene::Scene;
 use std::sync::Arc;
 
-/// The dynamic state of a world: the time and the substep count held after a raise; per body its particles' positions, velocities and
-/// rotations, its fixed flags and what has been cut; per tool its pose, target pose, velocity,
-/// last wrench, grasp and needle insertion.
+/// The dynamic state of a world: the time and the substep count held after a raise; per body
+/// its particles' positions, velocities and rotations, its fixed flags and what has been cut;
+/// per tool its pose, target pose, velocity, last wrench, grasp and needle insertion.
 ///
 /// The scene (meshes, materials, tool shapes, settings) is not part of it: a state applies to
 /// the world it was taken from or to one built the same way

@@ -8,9 +8,9 @@
 //! grows by about 0.9 e-folds per drop of the count, at `ω h` near 1.8 (one substep at the
 //! default `stability_margin` of 0.9 allows that): 0.32 e-folds a step when the count toggles
 //! every step, 0.08 when it is held 8 steps, 0.007 when it is held 128 (computed in this
-//! file's tests, which check the hold against it). A rule that toggles on a state near its threshold (a crushed
-//! tetrahedron at a tool) can toggle every step, and a part of the organ far from the tool then
-//! rings up until the step diverges (liver_1k6, a 2.5 mm probe pressed along +z:
+//! file's tests, which check the hold against it). A rule on a state near its threshold (a
+//! crushed tetrahedron at a tool) can toggle every step, and a part of the organ far from the
+//! tool then rings up until the step diverges (liver_1k6, a 2.5 mm probe pressed along +z:
 //! `examples/press_check.rs`). Held, a drop comes at most once per hold, and the material's
 //! damping removes what it adds.
 //!

@@ -393,7 +393,9 @@ impl World {
     /// for the explicit stability limit of the stiffest body, and enough that no tool moves
     /// (translation plus rotation at its bounding radius) more than one particle radius per
     /// substep, so that a fast tool is swept rather than teleported; a jump (faster than
-    /// [`World::tool_jump_speed`]) is not swept.
+    /// [`World::tool_jump_speed`]) is not swept. A count raised by these rules (or by the
+    /// crushed-tissue rules of [`Settings::crushed_substeps`]) is kept for
+    /// [`SUBSTEP_HOLD_STEPS`](crate::SUBSTEP_HOLD_STEPS) steps after they ask for less.
     pub fn substeps_needed(&self) -> (u32, bool) {
         self.scene.substeps_needed()
     }
