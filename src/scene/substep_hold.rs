@@ -11,7 +11,7 @@
 //! file's tests, which check the hold against it). A rule on a state near its threshold (a
 //! crushed tetrahedron at a tool) can toggle every step, and a part of the organ far from the
 //! tool then rings up until the step diverges (liver_1k6, a 2.5 mm probe pressed along +z:
-//! `examples/press_check.rs`). Held, a drop comes at most once per hold, and the material's
+//! `tests/contact_press_check.rs`). Held, a drop comes at most once per hold, and the material's
 //! damping removes what it adds.
 //!
 //! The hold is part of the scene's state ([`crate::WorldState`]), so a restored state steps the

@@ -1,8 +1,8 @@
-//! The contact goal's deep presses on any organ mesh (docs/VALIDATION.md §5): the organ hung by
-//! its top 15% and settled, a probe pressed horizontally through the middle of its rest bounding
-//! box at 5 cm/s from 2 mm off the surface, `--depth` past first contact, held, and withdrawn,
-//! from each side. Measured every step against the deformed boundary surface, independently of
-//! the library's own contact report:
+//! One deep press of the contact goal on a hung organ, measured every step against the deformed
+//! boundary surface, independently of the library's own contact report (docs/VALIDATION.md §5):
+//! the organ hung by its top 15% and settled, a sphere pressed horizontally through the middle of
+//! its rest bounding box at 5 cm/s from 2 mm off the surface, some depth past first contact,
+//! held, and withdrawn. Measured:
 //! - the probe's centre inside the organ (generalised winding number, `Body::contains`);
 //! - the depth of the surface inside the probe: the radius less the distance from the centre to
 //!   the nearest boundary triangle;
@@ -11,18 +11,12 @@
 //!   that diverged (rolled back by the library; the press goes on).
 //!
 //! A press meets the goal when the centre is never inside, the surface never more than a fifth
-//! of the radius inside the probe, no contact step pulls and no step diverges. A press whose probe touched the
-//! organ on less than 40% of its pressing steps (the press line grazes or misses the organ) is
-//! reported and not judged.
+//! of the radius inside the probe, no contact step pulls and no step diverges. A press whose
+//! probe touched the organ on less than 40% of its pressing steps (the press line grazes or
+//! misses the organ) is not judged.
 //!
-//! ```text
-//! cargo run --release --example press_check -- [--radii 1,2.5,5,10] [--sides +x,-x,+z,-z]
-//!     [--depth 0.03] [--hold 0.5] [--scale 0.03] [--crushed-substeps N] MESH...
-//! ```
-//! `MESH`: a mesh file (TetGen `.node`/`.ele` base, gmsh `.msh`, legacy `.vtk`) or the name of
-//! one in `data/meshes`; `--scale` its unit in metres (0.03: the data meshes' organs, 12–21 cm
-//! across); `--radii` the sphere radii (mm); `--depth` metres past first contact; `--hold`
-//! seconds. Exits non-zero when a judged press misses the goal.
+//! Shared by `examples/press_check` (any organ, from the command line) and the suite's
+//! `tests/contact_press_check.rs`.
 
 use parry3d_f64::math::{Point, Vector};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
@@ -32,7 +26,7 @@ use tissuesim::{mesh, tet_volume, Body, BodyOptions, Pose, Real, Settings, ToolO
 use tissuesim::{Error, World, WorldState};
 use tissuesim::{ToolShape, Vec3};
 
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+pub type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 /// Probe speed along the press (m/s).
 const SPEED: Real = 0.05;
@@ -46,34 +40,79 @@ const MOST_INSIDE: Real = 0.2;
 const LEAST_CONTACT: Real = 0.4;
 
 /// What one press measured.
-struct Press {
+pub struct Press {
     /// Largest depth (m) of the surface inside the probe; negative: it stayed outside.
-    deepest: Real,
+    pub deepest: Real,
     /// Steps with the probe's centre inside the deformed surface.
-    centre_inside: usize,
+    pub centre_inside: usize,
     /// Contact steps of the press and hold whose force pulled the probe along the press.
-    pulling: usize,
+    pub pulling: usize,
     /// Largest force (N) along the press on a pulling step.
-    strongest_pull: Real,
+    pub strongest_pull: Real,
     /// Steps of the press and hold in contact, of `pressing_steps`.
-    contact_steps: usize,
-    pressing_steps: usize,
+    pub contact_steps: usize,
+    pub pressing_steps: usize,
     /// Most tetrahedra inverted at once.
-    inverted: usize,
+    pub inverted: usize,
     /// Fastest particle (m/s).
-    fastest: Real,
+    pub fastest: Real,
     /// Steps that diverged and were rolled back (the tool moves on).
-    rolled_back: usize,
+    pub rolled_back: usize,
 }
 
+impl Press {
+    /// Whether the probe touched the organ on enough of its pressing steps to be judged.
+    pub fn touched(&self) -> bool {
+        self.contact_steps as Real >= LEAST_CONTACT * self.pressing_steps as Real
+    }
+
+    /// Whether the press of a sphere of `radius` (m) meets the goal.
+    pub fn meets(&self, radius: Real) -> bool {
+        self.centre_inside == 0
+            && self.deepest <= MOST_INSIDE * radius
+            && self.pulling == 0
+            && self.rolled_back == 0
+    }
+
+    /// The press as a row of the report: `name`, `radius` (m), `side`, then the figures and the
+    /// verdict.
+    pub fn row(&self, name: &str, radius: Real, side: &str) -> String {
+        let verdict = match (self.touched(), self.meets(radius)) {
+            (false, _) => "not judged (grazes the organ)",
+            (true, true) => "meets",
+            (true, false) => "misses",
+        };
+        format!(
+            "{name} | {} | {side} | {} | {:.2} | {} ({:.3}) | {} of {} | {} | {:.2} | {} | {verdict}",
+            radius * 1e3,
+            self.centre_inside,
+            self.deepest / radius,
+            self.pulling,
+            self.strongest_pull,
+            self.contact_steps,
+            self.pressing_steps,
+            self.inverted,
+            self.fastest,
+            self.rolled_back
+        )
+    }
+}
+
+/// The header of [`Press::row`].
+pub const HEADER: &str = "mesh | radius mm | side | centre inside | deepest / radius | pulling steps (strongest, N) | contact | most inverted | fastest m/s | rolled back | goal";
+
 /// The settled hanging organ that every press starts from.
-struct Hanging {
+pub struct Hanging {
     /// The body's model, shared by every press's world.
-    model: std::sync::Arc<tissuesim::BodyModel>,
+    pub model: std::sync::Arc<tissuesim::BodyModel>,
     /// The world's state once settled.
-    state: WorldState,
+    pub state: WorldState,
     /// The middle (m) of the rest bounding box, which the presses go through.
-    middle: Vec3,
+    pub middle: Vec3,
+    /// The boundary triangles once settled, where the presses start from.
+    pub triangles: Vec<Triangle>,
+    /// The body's contact skin (m).
+    pub skin: Real,
 }
 
 /// The mesh at `name`: a file, or a name in `data/meshes`.
@@ -89,7 +128,7 @@ fn mesh_path(name: &str) -> PathBuf {
 }
 
 /// Load `name` at `scale` (m per mesh unit), centre it, hang it by its top and settle it.
-fn hang(name: &str, scale: Real, settings: &Settings) -> Res<Hanging> {
+pub fn hang(name: &str, scale: Real, settings: &Settings) -> Res<Hanging> {
     let (mut organ, _) = mesh::load(&mesh_path(name), scale)?;
     let (lo, hi) = organ.bounding_box();
     let centre = (lo + hi) * 0.5;
@@ -112,6 +151,8 @@ fn hang(name: &str, scale: Real, settings: &Settings) -> Res<Hanging> {
     Ok(Hanging {
         model: b.model().clone(),
         state: world.state(),
+        triangles: surface(b),
+        skin: b.contact_skin(),
         middle: {
             let rest = b.rest_positions().iter();
             let (lo, hi) = rest.fold(
@@ -175,6 +216,34 @@ fn start(
     Some(centre)
 }
 
+/// The press of a sphere of `radius` (m) from `side` (`+x`, `-x`, `+z` or `-z`: the direction
+/// it moves in) through the middle of `organ`, `depth` (m) past first contact and held `hold`
+/// (s); `None` when the press line misses the organ.
+pub fn press_from(
+    organ: &Hanging,
+    settings: &Settings,
+    radius: Real,
+    side: &str,
+    (depth, hold): (Real, Real),
+) -> Res<Option<Press>> {
+    let m = organ.middle;
+    let (direction, through) = match side {
+        "+x" | "-x" => (Vec3::x(), Vec3::new(0.0, m.y, m.z)),
+        "+z" | "-z" => (Vec3::z(), Vec3::new(m.x, m.y, 0.0)),
+        s => return Err(format!("unknown side {s} (+x, -x, +z, -z)").into()),
+    };
+    let direction = if side.starts_with('-') {
+        -direction
+    } else {
+        direction
+    };
+    let line = (through, direction);
+    let Some(from) = start(&organ.triangles, line, radius, organ.skin) else {
+        return Ok(None);
+    };
+    press(organ, settings, radius, (from, direction), (depth, hold)).map(Some)
+}
+
 /// One press of a sphere of `radius` (m) from `start` along `direction`.
 fn press(
     organ: &Hanging,
@@ -232,129 +301,4 @@ fn press(
         }
     }
     Ok(p)
-}
-
-/// The value after `flag` in `args`, parsed, or `default`.
-fn option<T: std::str::FromStr>(args: &[String], flag: &str, default: T) -> Res<T>
-where
-    T::Err: std::error::Error + 'static,
-{
-    match args.iter().position(|a| a == flag) {
-        Some(i) => Ok(args
-            .get(i + 1)
-            .ok_or(format!("{flag} needs a value"))?
-            .parse()?),
-        None => Ok(default),
-    }
-}
-
-fn main() -> std::process::ExitCode {
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("press_check: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
-}
-
-/// Parse the arguments, run every press and report them.
-fn run() -> Res<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let radii: String = option(&args, "--radii", "1,2.5,5,10".to_string())?;
-    let sides: String = option(&args, "--sides", "+x,-x,+z,-z".to_string())?;
-    let depth: Real = option(&args, "--depth", 0.03)?;
-    let hold: Real = option(&args, "--hold", 0.5)?;
-    let scale: Real = option(&args, "--scale", 0.03)?;
-    let mut settings = Settings::default();
-    settings.crushed_substeps = option(&args, "--crushed-substeps", settings.crushed_substeps)?;
-    let valued = [
-        "--radii",
-        "--sides",
-        "--depth",
-        "--hold",
-        "--scale",
-        "--crushed-substeps",
-    ];
-    let meshes: Vec<&String> = (args.iter().enumerate())
-        .filter(|&(i, a)| {
-            !a.starts_with("--") && (i == 0 || !valued.contains(&args[i - 1].as_str()))
-        })
-        .map(|(_, a)| a)
-        .collect();
-    if meshes.is_empty() {
-        return Err("give at least one mesh (a file or a name in data/meshes)".into());
-    }
-    let radii: Vec<Real> = (radii.split(','))
-        .map(|r| r.trim().parse::<Real>().map(|mm| mm * 1e-3))
-        .collect::<Result<_, _>>()?;
-    let (mut judged, mut missed) = (0, Vec::new());
-    println!("mesh | radius mm | side | centre inside | deepest / radius | pulling steps (strongest, N) | contact | most inverted | fastest m/s | rolled back | goal");
-    for name in meshes {
-        let organ = hang(name, scale, &settings)?;
-        let middle = organ.middle;
-        let mut world = World::new(settings.clone())?;
-        let body = world.add_body_model(organ.model.clone());
-        world.set_state(&organ.state)?;
-        let (triangles, skin) = (surface(world.body(body)?), world.body(body)?.contact_skin());
-        for side in sides.split(',').map(str::trim) {
-            let (direction, through) = match side {
-                "+x" | "-x" => (Vec3::x(), Vec3::new(0.0, middle.y, middle.z)),
-                "+z" | "-z" => (Vec3::z(), Vec3::new(middle.x, middle.y, 0.0)),
-                s => return Err(format!("unknown side {s} (+x, -x, +z, -z)").into()),
-            };
-            let direction = if side.starts_with('-') {
-                -direction
-            } else {
-                direction
-            };
-            for &radius in &radii {
-                let Some(from) = start(&triangles, (through, direction), radius, skin) else {
-                    println!(
-                        "{name} | {} | {side} | the press line misses the organ",
-                        radius * 1e3
-                    );
-                    continue;
-                };
-                let p = press(&organ, &settings, radius, (from, direction), (depth, hold))?;
-                let touched = p.contact_steps as Real >= LEAST_CONTACT * p.pressing_steps as Real;
-                let meets = p.centre_inside == 0
-                    && p.deepest <= MOST_INSIDE * radius
-                    && p.pulling == 0
-                    && p.rolled_back == 0;
-                let verdict = match (touched, meets) {
-                    (false, _) => "not judged (grazes the organ)",
-                    (true, true) => "meets",
-                    (true, false) => "misses",
-                };
-                println!(
-                    "{name} | {} | {side} | {} | {:.2} | {} ({:.3}) | {} of {} | {} | {:.2} | {} | {verdict}",
-                    radius * 1e3,
-                    p.centre_inside,
-                    p.deepest / radius,
-                    p.pulling,
-                    p.strongest_pull,
-                    p.contact_steps,
-                    p.pressing_steps,
-                    p.inverted,
-                    p.fastest,
-                    p.rolled_back
-                );
-                if touched {
-                    judged += 1;
-                    if !meets {
-                        missed.push(format!("{name} {} mm {side}", radius * 1e3));
-                    }
-                }
-            }
-        }
-    }
-    println!(
-        "{} of {judged} judged presses meet the goal",
-        judged - missed.len()
-    );
-    if !missed.is_empty() {
-        return Err(format!("missed the goal: {}", missed.join(", ")).into());
-    }
-    Ok(())
 }
