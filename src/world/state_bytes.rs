@@ -21,9 +21,10 @@
 //! Particles are in each body's particle order (the mesh's nodes sorted for locality, a function
 //! of the mesh alone; version 4 introduced it, so older states are refused rather than
 //! restored onto the wrong particles). Cut pairs are indices into the neighbourhoods' pair
-//! slots, padded per particle (version 5). Version 6 added the substep hold. The scene itself (meshes, materials, settings) is not
-//! part of the state: a state restores into a world built the same way. Its size depends on the cuts, grasps and needle holds in
-//! force ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
+//! slots, padded per particle (version 5). Version 6 added the substep hold. The scene itself
+//! (meshes, materials, settings) is not part of the state: a state restores into a world built
+//! the same way. Its size depends on the cuts, grasps and needle holds in force
+//! ([`World::state_size`] at the time of saving). Restoring then stepping reproduces the
 //! original run bit for bit.
 //!
 //! Reading ([`WorldState::from_bytes`]) needs no world: it checks the magic, the version, the
