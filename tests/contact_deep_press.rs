@@ -263,6 +263,32 @@ fn a_capsule_and_a_box_pressed_3_cm_from_four_sides_stay_outside() {
     );
 }
 
+/// With surface self-contact on, the rod (which once got the surface 4.9 mm in with it on)
+/// and the 2.5 mm sphere still stay outside from four sides: the tissue held apart from itself
+/// around a probe does not push its surface into the probe (measured: the surface 0.6 mm or
+/// more outside both; one contact step of the rod along +x, of 1,140, pulls it in).
+#[test]
+fn with_self_contact_on_the_rod_and_a_sphere_stay_outside() {
+    let plan = Plan {
+        settings: Settings {
+            self_contact: true,
+            ..Settings::default()
+        },
+        ..three_cm()
+    };
+    check_probes(
+        &hanging_organ(mesh::default_organ()),
+        &plan,
+        &[
+            (rod(), REACH),
+            (ToolShape::Sphere { radius: 0.0025 }, 0.0025),
+        ],
+        "with self-contact, the probe's centre inside the organ, or the surface more than a \
+         fifth of the radius inside it",
+        |radius, p| p.centre_inside > 0 || p.deepest > MOST_INSIDE * radius,
+    );
+}
+
 /// Every contact step of every probe pushes back: the tissue's force on the probe never has a
 /// component along the press. (On the paper's particles one step each of the 1 mm sphere and of
 /// the cube pressed along +z, of about 1,000 in contact, pulled forward: 0.05 and 0.57 N beside

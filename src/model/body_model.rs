@@ -13,6 +13,7 @@
 //! (copy-on-write, [`Arc::make_mut`]), so the other holders keep the uncut model.
 
 use crate::error::{check_finite, check_positive, Error};
+use crate::kernels::collision::surface_tree::SurfaceTree;
 use crate::kernels::colouring::TetColouring;
 use crate::kernels::math::{is_finite_vec, tet_volume, Real, Vec3};
 use crate::kernels::neighbours::{self, Neighbourhoods, SupportRadius};
@@ -234,6 +235,9 @@ pub struct BodyModel {
     pub(crate) boundary: Vec<[u32; 3]>,
     /// The particles at the boundary triangles' corners, each once, increasing.
     pub(crate) boundary_vertices: Vec<u32>,
+    /// The bounding-volume hierarchy of the boundary triangles at rest, the self-contact's
+    /// broad phase.
+    pub(crate) boundary_tree: SurfaceTree,
     /// Contact radius of the particles (m).
     pub(crate) particle_radius: Real,
     /// Centre of the rest bounding box (m).
@@ -336,6 +340,7 @@ impl BodyModel {
             tet_rest_volume,
             tets: mesh.tets.clone(),
             boundary_vertices: crate::mesh::boundary_vertices(&boundary),
+            boundary_tree: SurfaceTree::new(&mesh.nodes, &boundary),
             boundary,
             particle_radius: options
                 .particle_radius
@@ -417,6 +422,7 @@ impl BodyModel {
             + self.dual_cells.heap_bytes()
             + self.tet_elements.heap_bytes()
             + self.tet_dashpots.heap_bytes()
+            + self.boundary_tree.heap_bytes()
             + 2 * size_of_val(self.order.mesh_indices())
     }
 }

@@ -21,6 +21,7 @@
 //! removed in place. The set of cut pairs and tetrahedra is part of the saved state; restoring
 //! a state rebuilds the body's topology from the load-time data it keeps after the first cut.
 
+use crate::kernels::collision::surface_tree::SurfaceTree;
 use crate::kernels::colouring::TetColouring;
 use crate::kernels::math::{Mat3, Real, Vec3};
 use crate::kernels::neighbours::Neighbourhoods;
@@ -247,6 +248,7 @@ fn apply(body: &mut Body, mut state: Box<CutState>, changed: Option<&[usize]>) -
     };
     model.boundary = mesh.boundary_triangles();
     model.boundary_vertices = crate::mesh::boundary_vertices(&model.boundary);
+    model.boundary_tree = SurfaceTree::new(&model.rest, &model.boundary);
     // Keep the step stable on the new topology.
     body.derived.restabilise(&body.model, &state.base);
     body.update_inverse_masses();

@@ -41,20 +41,18 @@
 //! body's; frictionless unless set) on the vertex's motion relative to the foot, spread the
 //! same way.
 //!
-//! Broad phase: a grid of the triangles' boxes on the predicted positions ([`TriangleGrid`]),
-//! grown by `s` plus twice the largest motion of a boundary vertex in the substep, up to a
-//! particle radius (so that a vertex that crossed a triangle within the substep is in its
-//! box); each boundary vertex looks
-//! in its own cell, and not even there when its normal is within 90° of the cone of the cell's
-//! triangle normals (condition 2 would turn all of them away). It costs one pass over the
-//! boundary triangles and over the grid's cells, and a few box tests per boundary vertex not
-//! skipped, most of which (the triangles around it) condition 1 or 2 turn away.
-//! Everything runs on the calling thread, the
-//! vertices in increasing order and the triangles of a cell in boundary order: the same bits
-//! for any thread count.
+//! Broad phase: the body's [`SurfaceTree`](crate::kernels::collision::surface_tree), a
+//! bounding-volume hierarchy of its boundary triangles made at rest, refitted every pass to
+//! the boxes of the positions at the substep's start and the predicted ones (the triangles'
+//! grown by `s`, so that a vertex that crossed a triangle within the substep meets its box)
+//! and to the cones of the unit normals. Subtrees whose boxes miss each other, or whose
+//! normals cannot face each other (condition 2), are skipped whole; within a pair of leaves a
+//! vertex is skipped by its own box and normal. It costs a pass over the boundary triangles
+//! (normals), a refit of the tree and its traversal. Everything runs on the calling thread in
+//! the tree's order: the same bits for any thread count.
 
 use crate::interaction::surface_contact::MAX_CORNER_SHARE;
-use crate::kernels::collision::triangle_grid::TriangleGrid;
+use crate::kernels::collision::surface_tree::TreeFit;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
 use crate::model::body_model::BodyModel;
@@ -72,11 +70,12 @@ pub(crate) const SELF_CONTACT_SKIN: Real = 0.5;
 /// Scratch memory of this pass, kept by the pipeline between steps, sized for the largest body.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SelfContactScratch {
-    grid: TriangleGrid,
+    fit: TreeFit,
     /// Per boundary triangle, its unit outward normal at the start of the pass.
     normal: Vec<Vec3>,
-    /// Per particle, the sum of the cross products of the boundary triangles around it (m²;
-    /// written for boundary vertices only).
+    /// Per particle, the unit normal of the boundary around it: the sum of the cross products
+    /// of the boundary triangles around it, normalised (zero where that sum is; written for
+    /// boundary vertices only).
     vertex_normal: Vec<Vec3>,
 }
 
@@ -84,7 +83,7 @@ impl SelfContactScratch {
     /// Make room for a body on `model` (allocates only when the scratch is smaller).
     pub(crate) fn reserve(&mut self, model: &BodyModel) {
         let (triangles, particles) = (model.boundary.len(), model.particle_count());
-        self.grid.reserve(triangles);
+        self.fit.reserve(&model.boundary_tree, particles);
         if self.normal.len() < triangles {
             self.normal.resize(triangles, Vec3::zeros());
         }
@@ -115,7 +114,7 @@ pub(crate) fn project_self_contacts(
     let (x, w, rest) = (&body.state.x, &body.inv_mass, &model.rest);
     let p = &mut step.p;
     let SelfContactScratch {
-        grid,
+        fit,
         normal,
         vertex_normal,
     } = scratch;
@@ -130,87 +129,76 @@ pub(crate) fn project_self_contacts(
         }
         normal[t] = area_normal.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
     }
-    // A vertex and a triangle that both moved by at most `motion` in this substep cross the
-    // triangle's plane by at most `2 motion`: the boxes are grown by that beyond the skin, up
-    // to a particle radius of motion (the most a tool moves in a substep).
-    let motion = (model.boundary_vertices.iter())
-        .map(|&i| (p[i as usize] - x[i as usize]).norm_squared())
-        .fold(0.0, Real::max)
-        .sqrt()
-        .min(model.particle_radius);
-    grid.build(p, boundary, normal, skin + 2.0 * motion);
     for &i in &model.boundary_vertices {
-        let i = i as usize;
-        let facing = vertex_normal[i];
+        let n = &mut vertex_normal[i as usize];
         // A zero normal faces no triangle (condition 2).
-        let Some(direction) = facing.try_normalize(0.0) else {
-            continue;
-        };
-        let query = p[i];
-        grid.for_each_containing(&query, &direction, |t| {
-            let n = normal[t];
-            if boundary[t].contains(&(i as u32)) || n.dot(&facing) >= 0.0 {
-                return;
-            }
-            let corners = boundary[t].map(|k| k as usize);
-            let [a, b, c] = corners.map(|k| p[k]);
-            let height = (p[i] - a).dot(&n);
-            if height >= skin {
-                return;
-            }
-            let Some(weights) = contact_weights(&p[i], [a, b, c], skin) else {
-                return;
-            };
-            let [a0, b0, c0] = corners.map(|k| x[k]);
-            let n0 = (b0 - a0).cross(&(c0 - a0)).try_normalize(0.0).unwrap_or(n);
-            let start = (x[i] - a0).dot(&n0);
-            if start < 0.0 || n0.dot(&n) <= 0.0 {
-                return;
-            }
-            if height < 0.0 {
-                // Crossed the plane in this substep: only through the triangle (or within the
-                // skin of it), at the fraction of the substep where the height went through 0.
-                let at = start / (start - height);
-                let then = |k: usize| x[k] + (p[k] - x[k]) * at;
-                if contact_weights(&then(i), corners.map(then), skin).is_none() {
-                    return;
-                }
-            }
-            // Stop a crossing whole; lift a vertex that was within the skin at the start by at
-            // most `max_correction`.
-            let depth = skin.min(start + max_correction) - height;
-            if depth <= 0.0 {
-                return;
-            }
-            let [ra, rb, rc] = corners.map(|k| Point::from(rest[k]));
-            let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
-            if at_rest < skin {
-                return;
-            }
-            let wk = corners.map(|k| w[k]);
-            let total = w[i]
-                + (0..3)
-                    .map(|k| weights[k] * weights[k] * wk[k])
-                    .sum::<Real>();
-            if total <= 0.0 {
-                return;
-            }
-            let own = w[i] / total;
-            let shares = [0, 1, 2].map(|k| (weights[k] * wk[k] / total).min(MAX_CORNER_SHARE));
-            let spread = |p: &mut [Vec3], shift: Vec3| {
-                p[i] += shift * own;
-                for k in 0..3 {
-                    p[corners[k]] -= shift * shares[k];
-                }
-            };
-            spread(p, n * depth);
-            let foot_motion: Vec3 = (0..3)
-                .map(|k| (p[corners[k]] - x[corners[k]]) * weights[k])
-                .sum();
-            let relative = (p[i] - x[i]) - foot_motion;
-            spread(p, friction_correction(&relative, &n, depth, mu_s, mu_k));
-        });
+        *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
     }
+    let tree = &model.boundary_tree;
+    fit.refit(tree, boundary, (x, p), (normal, vertex_normal), skin);
+    fit.for_each_candidate(tree, p, vertex_normal, |i, t, p| {
+        let n = normal[t];
+        if boundary[t].contains(&(i as u32)) || n.dot(&vertex_normal[i]) >= 0.0 {
+            return;
+        }
+        let corners = boundary[t].map(|k| k as usize);
+        let [a, b, c] = corners.map(|k| p[k]);
+        let height = (p[i] - a).dot(&n);
+        if height >= skin {
+            return;
+        }
+        let [a0, b0, c0] = corners.map(|k| x[k]);
+        let n0 = (b0 - a0).cross(&(c0 - a0)).try_normalize(0.0).unwrap_or(n);
+        let start = (x[i] - a0).dot(&n0);
+        if start < 0.0 || n0.dot(&n) <= 0.0 {
+            return;
+        }
+        let Some(weights) = contact_weights(&p[i], [a, b, c], skin) else {
+            return;
+        };
+        if height < 0.0 {
+            // Crossed the plane in this substep: only through the triangle (or within the
+            // skin of it), at the fraction of the substep where the height went through 0.
+            let at = start / (start - height);
+            let then = |k: usize| x[k] + (p[k] - x[k]) * at;
+            if contact_weights(&then(i), corners.map(then), skin).is_none() {
+                return;
+            }
+        }
+        // Stop a crossing whole; lift a vertex that was within the skin at the start by at
+        // most `max_correction`.
+        let depth = skin.min(start + max_correction) - height;
+        if depth <= 0.0 {
+            return;
+        }
+        let [ra, rb, rc] = corners.map(|k| Point::from(rest[k]));
+        let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
+        if at_rest < skin {
+            return;
+        }
+        let wk = corners.map(|k| w[k]);
+        let total = w[i]
+            + (0..3)
+                .map(|k| weights[k] * weights[k] * wk[k])
+                .sum::<Real>();
+        if total <= 0.0 {
+            return;
+        }
+        let own = w[i] / total;
+        let shares = [0, 1, 2].map(|k| (weights[k] * wk[k] / total).min(MAX_CORNER_SHARE));
+        let spread = |p: &mut [Vec3], shift: Vec3| {
+            p[i] += shift * own;
+            for k in 0..3 {
+                p[corners[k]] -= shift * shares[k];
+            }
+        };
+        spread(p, n * depth);
+        let foot_motion: Vec3 = (0..3)
+            .map(|k| (p[corners[k]] - x[corners[k]]) * weights[k])
+            .sum();
+        let relative = (p[i] - x[i]) - foot_motion;
+        spread(p, friction_correction(&relative, &n, depth, mu_s, mu_k));
+    });
 }
 
 /// Where the contact of the point `q` with the triangle `a b c` (m) acts on the triangle, as

@@ -1,10 +1,10 @@
 //! Collision geometry without state: the paper's sampling of a tool surface into points, the
-//! spatial hash grid of the organ–organ broad phase, the grid of triangle boxes of the surface
+//! spatial hash grid of the organ–organ broad phase, the bounding-volume hierarchy of the surface
 //! self-contact's broad phase, and the inside test of a closed surface (winding number). The
 //! tools themselves are scene objects ([`crate::scene::tool`]); the contact passes that use these
 //! are in [`crate::interaction`] and [`crate::solver`].
 
 pub mod hash_grid;
 pub mod sampling;
-pub(crate) mod triangle_grid;
+pub(crate) mod surface_tree;
 pub(crate) mod winding;

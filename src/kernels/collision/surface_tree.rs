@@ -1,0 +1,553 @@
+//! A bounding-volume hierarchy over a body's boundary triangles, the broad phase of the surface
+//! self-contact: which boundary vertices can touch which boundary triangles of the same body.
+//!
+//! The tree's shape is made once from the rest positions ([`SurfaceTree::new`]: the triangles
+//! split at the median of their rest centroids along the longest side of their box, down to
+//! leaves of at most [`LEAF_TRIANGLES`]) and kept until the boundary changes (a cut). Every
+//! boundary vertex belongs to one leaf, the first (in the tree's order) with a triangle at it,
+//! so that a subtree holds a run of the triangles and a run of the vertices.
+//!
+//! Every pass refits it ([`SurfaceTree::refit`]): per node the box of its triangles' corners at
+//! the start of the substep and at the predicted positions, grown by the contact skin, the box
+//! of its vertices at both, and the cones of its triangles' unit normals and of its vertices'
+//! unit normals (an axis and a half-angle). A vertex and a triangle can only be in contact when
+//! the vertex's box meets the triangle's grown box (it is within the skin of the triangle, or
+//! crossed it, somewhere between the two positions) and their normals face each other (more
+//! than 90° apart). So a pair of subtrees is skipped when the boxes miss each other, or when
+//! the angle between the cones' axes plus both half-angles is under 90° (no vertex normal of one
+//! faces any triangle normal of the other); a subtree is skipped against itself by the same
+//! cone test (a patch of surface that turns by less than 45° everywhere cannot touch itself).
+//! Where the surface is far from itself and smooth, that leaves a refit and a few node tests.
+//!
+//! [`SurfaceTree::for_each_candidate`] visits the pairs the tests leave, leaf by leaf, in an
+//! order fixed by the tree and the positions: the same pairs in the same order for any thread
+//! count and after a saved state is restored.
+
+use crate::kernels::math::{Real, Vec3};
+
+/// Most triangles in a leaf (dimensionless). Smaller leaves hold tighter cones (fewer pairs
+/// tested exactly) but make more nodes to refit and visit.
+pub(crate) const LEAF_TRIANGLES: usize = 4;
+
+/// Least cosine (dimensionless) of the widest angle between a vertex normal and a triangle
+/// normal for a pair of nodes to be skipped: far above rounding, so that every skipped pair has
+/// a positive dot product of normals, as the exact test computes it.
+const FACING_MARGIN: Real = 1.0e-9;
+
+/// A node: a run `tris` of the tree's triangle order and a run `verts` of its vertex order; an
+/// inner node's children follow it (`left` is the next node).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Node {
+    tris: (u32, u32),
+    verts: (u32, u32),
+    /// The right child (an index of the node array), or [`Node::LEAF`].
+    right: u32,
+}
+
+impl Node {
+    const LEAF: u32 = u32::MAX;
+
+    fn is_leaf(&self) -> bool {
+        self.right == Node::LEAF
+    }
+
+    fn size(&self) -> u32 {
+        self.tris.1 - self.tris.0
+    }
+}
+
+/// A cone of unit vectors: those within the half-angle `θ` (`cos θ`, `sin θ`) of `axis`.
+/// [`Cone::EMPTY`] holds none, a cosine of −1 all.
+#[derive(Debug, Clone, Copy)]
+struct Cone {
+    axis: Vec3,
+    cos: Real,
+    sin: Real,
+}
+
+impl Cone {
+    const EMPTY: Cone = Cone {
+        axis: Vec3::new(0.0, 0.0, 0.0),
+        cos: Real::INFINITY,
+        sin: 0.0,
+    };
+    const FULL: Cone = Cone {
+        axis: Vec3::new(0.0, 0.0, 1.0),
+        cos: -1.0,
+        sin: 0.0,
+    };
+
+    /// The cone of the one unit vector `u`, or [`Cone::EMPTY`] for a zero vector.
+    fn unit(u: Vec3) -> Cone {
+        if u == Vec3::zeros() {
+            return Cone::EMPTY;
+        }
+        Cone {
+            axis: u,
+            cos: 1.0,
+            sin: 0.0,
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.cos == Real::INFINITY
+    }
+
+    /// The cone of the unit vectors `units` (zero vectors left out).
+    fn of(units: impl Iterator<Item = Vec3> + Clone) -> Cone {
+        let nonzero = units.filter(|u| *u != Vec3::zeros());
+        let Some(axis) = nonzero.clone().sum::<Vec3>().try_normalize(0.0) else {
+            return match nonzero.clone().next() {
+                Some(_) => Cone::FULL,
+                None => Cone::EMPTY,
+            };
+        };
+        let cos = nonzero.map(|u| axis.dot(&u)).fold(1.0, Real::min).max(-1.0);
+        Cone {
+            axis,
+            cos,
+            sin: (1.0 - cos * cos).max(0.0).sqrt(),
+        }
+    }
+
+    /// The half-angle (as cosine and sine) about `axis` of a cone holding `self`, or `None` when
+    /// it is 180° or more.
+    fn about(&self, axis: &Vec3) -> Option<(Real, Real)> {
+        let c = axis.dot(&self.axis).clamp(-1.0, 1.0);
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        let sin = s * self.cos + c * self.sin;
+        (sin >= 0.0 && self.cos > -1.0).then_some((c * self.cos - s * self.sin, sin))
+    }
+
+    /// A cone holding both.
+    fn union(&self, other: &Cone) -> Cone {
+        if self.is_empty() {
+            return *other;
+        }
+        if other.is_empty() {
+            return *self;
+        }
+        let Some(axis) = (self.axis + other.axis).try_normalize(0.0) else {
+            return Cone::FULL;
+        };
+        match (self.about(&axis), other.about(&axis)) {
+            (Some(a), Some(b)) => {
+                let (cos, sin) = if a.0 <= b.0 { a } else { b };
+                Cone { axis, cos, sin }
+            }
+            _ => Cone::FULL,
+        }
+    }
+
+    /// Whether every vector of `self` is less than 90° (with [`FACING_MARGIN`]) from every
+    /// vector of `other`: none faces another. True when either holds none.
+    fn never_faces(&self, other: &Cone) -> bool {
+        if self.is_empty() || other.is_empty() {
+            return true;
+        }
+        // cos and sin of γ = the angle between the axes, then of γ + θ₁, then of γ + θ₁ + θ₂,
+        // each kept under 90°.
+        let c = self.axis.dot(&other.axis).clamp(-1.0, 1.0);
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        if c <= 0.0 || self.cos <= 0.0 || other.cos <= 0.0 {
+            return false;
+        }
+        let (c1, s1) = (c * self.cos - s * self.sin, s * self.cos + c * self.sin);
+        c1 > 0.0 && c1 * other.cos - s1 * other.sin > FACING_MARGIN
+    }
+}
+
+/// An axis-aligned box (m): lower and upper corners; [`EMPTY_BOX`] holds nothing.
+type Aabb = (Vec3, Vec3);
+
+const EMPTY_BOX: Aabb = (
+    Vec3::new(Real::INFINITY, Real::INFINITY, Real::INFINITY),
+    Vec3::new(-Real::INFINITY, -Real::INFINITY, -Real::INFINITY),
+);
+
+fn grow(b: &mut Aabb, p: &Vec3) {
+    b.0 = b.0.inf(p);
+    b.1 = b.1.sup(p);
+}
+
+fn merge(a: &Aabb, b: &Aabb) -> Aabb {
+    (a.0.inf(&b.0), a.1.sup(&b.1))
+}
+
+fn overlap(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+/// The tree's shape (see the module documentation), made from the rest positions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct SurfaceTree {
+    /// Nodes in depth-first order (a node's left child is the next one), the root first.
+    nodes: Vec<Node>,
+    /// Boundary triangles (indices into the body's boundary) in the tree's order.
+    triangles: Vec<u32>,
+    /// Boundary vertices (particle indices) in the tree's order.
+    vertices: Vec<u32>,
+}
+
+/// The boxes and cones of a [`SurfaceTree`]'s nodes at the last refit, one entry per node.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TreeFit {
+    /// Its triangles' corners' box grown by the skin, and its vertices' box (m).
+    triangle_box: Vec<Aabb>,
+    vertex_box: Vec<Aabb>,
+    /// The cones of its triangles' and of its vertices' unit normals.
+    triangle_cone: Vec<Cone>,
+    vertex_cone: Vec<Cone>,
+    /// Per particle, the box of its position at the substep's start and its predicted one (m;
+    /// written for boundary vertices only).
+    hull: Vec<Aabb>,
+}
+
+impl SurfaceTree {
+    /// The tree over `boundary` (corner particle indices) at the rest positions `rest` (m).
+    pub(crate) fn new(rest: &[Vec3], boundary: &[[u32; 3]]) -> SurfaceTree {
+        let mut tree = SurfaceTree {
+            triangles: (0..boundary.len() as u32).collect(),
+            ..SurfaceTree::default()
+        };
+        if boundary.is_empty() {
+            return tree;
+        }
+        let centroid = |t: u32| {
+            let [a, b, c] = boundary[t as usize].map(|k| rest[k as usize]);
+            (a + b + c) / 3.0
+        };
+        tree.split(0, boundary.len(), &centroid);
+        // Vertices to the first leaf with a triangle at them, leaf by leaf in order.
+        let mut taken = vec![false; rest.len()];
+        for n in 0..tree.nodes.len() {
+            let node = tree.nodes[n];
+            if !node.is_leaf() {
+                continue;
+            }
+            let start = tree.vertices.len() as u32;
+            for &t in &tree.triangles[node.tris.0 as usize..node.tris.1 as usize] {
+                for k in boundary[t as usize] {
+                    if !std::mem::replace(&mut taken[k as usize], true) {
+                        tree.vertices.push(k);
+                    }
+                }
+            }
+            tree.nodes[n].verts = (start, tree.vertices.len() as u32);
+        }
+        for n in (0..tree.nodes.len()).rev() {
+            let node = tree.nodes[n];
+            if !node.is_leaf() {
+                let (left, right) = (tree.nodes[n + 1], tree.nodes[node.right as usize]);
+                tree.nodes[n].verts = (left.verts.0, right.verts.1);
+            }
+        }
+        tree
+    }
+
+    /// Make the subtree of the triangles `start..end` of the tree's order; returns its node.
+    fn split(&mut self, start: usize, end: usize, centroid: &impl Fn(u32) -> Vec3) -> u32 {
+        let n = self.nodes.len();
+        self.nodes.push(Node {
+            tris: (start as u32, end as u32),
+            verts: (0, 0),
+            right: Node::LEAF,
+        });
+        if end - start <= LEAF_TRIANGLES {
+            return n as u32;
+        }
+        let mut bounds = EMPTY_BOX;
+        for &t in &self.triangles[start..end] {
+            grow(&mut bounds, &centroid(t));
+        }
+        let side = bounds.1 - bounds.0;
+        let axis = (0..3).fold(0, |a, k| if side[k] > side[a] { k } else { a });
+        let mid = (start + end) / 2;
+        self.triangles[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+            let (ca, cb) = (centroid(a)[axis], centroid(b)[axis]);
+            ca.total_cmp(&cb).then(a.cmp(&b))
+        });
+        self.split(start, mid, centroid);
+        let right = self.split(mid, end, centroid);
+        self.nodes[n].right = right;
+        n as u32
+    }
+
+    /// Bytes held on the heap.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.nodes.capacity() * size_of::<Node>()
+            + 4 * (self.triangles.capacity() + self.vertices.capacity())
+    }
+}
+
+impl TreeFit {
+    /// Make room for `tree`'s nodes and `particles` particles (allocates only when it holds
+    /// fewer).
+    pub(crate) fn reserve(&mut self, tree: &SurfaceTree, particles: usize) {
+        if self.hull.len() < particles {
+            self.hull.resize(particles, EMPTY_BOX);
+        }
+        let count = tree.nodes.len();
+        if self.triangle_box.len() < count {
+            self.triangle_box.resize(count, EMPTY_BOX);
+            self.vertex_box.resize(count, EMPTY_BOX);
+            self.triangle_cone.resize(count, Cone::EMPTY);
+            self.vertex_cone.resize(count, Cone::EMPTY);
+        }
+    }
+
+    /// Refit the boxes and cones of `tree` (see the module documentation) to the positions `x` at the
+    /// substep's start and `p` predicted (m), the triangles' unit normals `normal` (per boundary
+    /// triangle, zero for a degenerate one) and the vertices' unit normals `vertex_normal` (per
+    /// particle, zero for a vertex that faces nothing), the triangles' boxes grown by `skin` (m).
+    /// Needs [`TreeFit::reserve`] for `tree`.
+    pub(crate) fn refit(
+        &mut self,
+        tree: &SurfaceTree,
+        boundary: &[[u32; 3]],
+        (x, p): (&[Vec3], &[Vec3]),
+        (normal, vertex_normal): (&[Vec3], &[Vec3]),
+        skin: Real,
+    ) {
+        for &k in &tree.vertices {
+            let k = k as usize;
+            self.hull[k] = (x[k].inf(&p[k]), x[k].sup(&p[k]));
+        }
+        let hull = &self.hull;
+        for n in (0..tree.nodes.len()).rev() {
+            let node = tree.nodes[n];
+            if node.is_leaf() {
+                let tris = &tree.triangles[node.tris.0 as usize..node.tris.1 as usize];
+                let verts = &tree.vertices[node.verts.0 as usize..node.verts.1 as usize];
+                let corners = (tris.iter().flat_map(|&t| boundary[t as usize]))
+                    .fold(EMPTY_BOX, |b, k| merge(&b, &hull[k as usize]));
+                self.triangle_box[n] = (corners.0.add_scalar(-skin), corners.1.add_scalar(skin));
+                self.vertex_box[n] =
+                    (verts.iter()).fold(EMPTY_BOX, |b, &k| merge(&b, &hull[k as usize]));
+                self.triangle_cone[n] = Cone::of(tris.iter().map(|&t| normal[t as usize]));
+                self.vertex_cone[n] = Cone::of(verts.iter().map(|&k| vertex_normal[k as usize]));
+            } else {
+                let (l, r) = (n + 1, node.right as usize);
+                self.triangle_box[n] = merge(&self.triangle_box[l], &self.triangle_box[r]);
+                self.vertex_box[n] = merge(&self.vertex_box[l], &self.vertex_box[r]);
+                self.triangle_cone[n] = self.triangle_cone[l].union(&self.triangle_cone[r]);
+                self.vertex_cone[n] = self.vertex_cone[l].union(&self.vertex_cone[r]);
+            }
+        }
+    }
+
+    /// Whether the vertices of node `a` can touch the triangles of node `b` (last refit).
+    fn may_touch(&self, a: usize, b: usize) -> bool {
+        overlap(&self.vertex_box[a], &self.triangle_box[b])
+            && !self.vertex_cone[a].never_faces(&self.triangle_cone[b])
+    }
+
+    /// Call `visit(vertex, triangle)` (a particle index, an index of the boundary) for every
+    /// pair of a vertex and a triangle in leaves that the last refit's boxes and cones do not
+    /// keep apart (see the module documentation), leaf pair by leaf pair. A vertex is visited
+    /// with the triangles around it too: the exact test turns those away.
+    pub(crate) fn for_each_candidate(
+        &self,
+        tree: &SurfaceTree,
+        p: &mut [Vec3],
+        vertex_normal: &[Vec3],
+        mut visit: impl FnMut(usize, usize, &mut [Vec3]),
+    ) {
+        if tree.nodes.is_empty() {
+            return;
+        }
+        // Depth-first over (vertices of a, triangles of b) node pairs; a pair with a == b is a
+        // node against itself. Pending pairs: a node against itself leaves three for each
+        // level it descends, a pair of nodes one for each level either descends, so at most
+        // five times the depth plus one; median splits keep the depth under 32 for any `u32`
+        // count of triangles.
+        let mut stack = [(0u32, 0u32); 5 * 32 + 1];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (a, b) = (stack[top].0 as usize, stack[top].1 as usize);
+            if !self.may_touch(a, b) {
+                continue;
+            }
+            let (na, nb) = (tree.nodes[a], tree.nodes[b]);
+            let mut push = |a: usize, b: usize| {
+                stack[top] = (a as u32, b as u32);
+                top += 1;
+            };
+            if a == b && !na.is_leaf() {
+                let (l, r) = (a + 1, na.right as usize);
+                push(r, l);
+                push(l, r);
+                push(r, r);
+                push(l, l);
+            } else if na.is_leaf() && nb.is_leaf() {
+                let verts = &tree.vertices[na.verts.0 as usize..na.verts.1 as usize];
+                let tris = &tree.triangles[nb.tris.0 as usize..nb.tris.1 as usize];
+                let (reach, cone) = (&self.triangle_box[b], &self.triangle_cone[b]);
+                for &i in verts {
+                    let i = i as usize;
+                    if !overlap(&self.hull[i], reach)
+                        || Cone::unit(vertex_normal[i]).never_faces(cone)
+                    {
+                        continue;
+                    }
+                    for &t in tris {
+                        visit(i, t as usize, p);
+                    }
+                }
+            } else if !na.is_leaf() && (nb.is_leaf() || na.size() >= nb.size()) {
+                push(na.right as usize, b);
+                push(a + 1, b);
+            } else {
+                push(a, nb.right as usize);
+                push(a, b + 1);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed sphere of radius 1 (m): `rings` rings of `segments` vertices between two poles,
+    /// triangles wound outwards.
+    fn sphere(rings: usize, segments: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut v = vec![Vec3::new(0.0, 0.0, 1.0)];
+        for r in 1..=rings {
+            let polar = std::f64::consts::PI * r as Real / (rings + 1) as Real;
+            for s in 0..segments {
+                let azimuth = std::f64::consts::TAU * s as Real / segments as Real;
+                let (sp, cp) = polar.sin_cos();
+                v.push(Vec3::new(sp * azimuth.cos(), sp * azimuth.sin(), cp));
+            }
+        }
+        v.push(Vec3::new(0.0, 0.0, -1.0));
+        let at = |r: usize, s: usize| (1 + (r - 1) * segments + s % segments) as u32;
+        let south = (v.len() - 1) as u32;
+        let mut t = Vec::new();
+        for s in 0..segments {
+            t.push([0, at(1, s), at(1, s + 1)]);
+            t.push([south, at(rings, s + 1), at(rings, s)]);
+            for r in 1..rings {
+                t.push([at(r, s), at(r + 1, s), at(r + 1, s + 1)]);
+                t.push([at(r, s), at(r + 1, s + 1), at(r, s + 1)]);
+            }
+        }
+        (v, t)
+    }
+
+    fn unit_normals(p: &[Vec3], boundary: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
+        let mut vertex = vec![Vec3::zeros(); p.len()];
+        let triangle = (boundary.iter())
+            .map(|c| {
+                let [a, b, d] = c.map(|k| p[k as usize]);
+                let n = (b - a).cross(&(d - a));
+                c.iter().for_each(|&k| vertex[k as usize] += n);
+                n.try_normalize(0.0).unwrap_or_else(Vec3::zeros)
+            })
+            .collect();
+        let vertex = vertex
+            .iter()
+            .map(|n| n.try_normalize(0.0).unwrap_or_else(Vec3::zeros));
+        (triangle, vertex.collect())
+    }
+
+    /// Every pair the exact test could keep is visited, exactly once: a vertex facing a
+    /// triangle (normals more than 90° apart) that is not one of its corners, the box of its
+    /// two positions meeting the triangle's box at both grown by the skin. On a sphere pressed
+    /// flat between two planes until its caps nearly touch, with random jitter, so that the
+    /// caps face each other within the skin and its rim is sharp.
+    #[test]
+    fn visits_every_pair_the_exact_test_could_keep_exactly_once() {
+        let (rest, boundary) = sphere(24, 40);
+        let tree = SurfaceTree::new(&rest, &boundary);
+        let mut seed = 11u64;
+        let mut random = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        for squash in [1.0, 0.3, 0.05, 0.01] {
+            let mut jitter = || Vec3::new(random(), random(), random()) * 0.004;
+            let x: Vec<Vec3> = (rest.iter())
+                .map(|r| Vec3::new(r.x, r.y, r.z * squash) + jitter())
+                .collect();
+            let mut p: Vec<Vec3> = x.iter().map(|x| x + jitter()).collect();
+            let (normal, vertex_normal) = unit_normals(&p, &boundary);
+            let skin = 0.02;
+            let mut fit = TreeFit::default();
+            fit.reserve(&tree, rest.len());
+            fit.refit(&tree, &boundary, (&x, &p), (&normal, &vertex_normal), skin);
+            let mut visits = vec![0u8; rest.len() * boundary.len()];
+            fit.for_each_candidate(&tree, &mut p, &vertex_normal, |i, t, _| {
+                visits[i * boundary.len() + t] += 1;
+            });
+            assert!(visits.iter().all(|&v| v <= 1), "a pair visited twice");
+            let mut needed = 0;
+            for (t, corners) in boundary.iter().enumerate() {
+                let b = corners.iter().fold(EMPTY_BOX, |b, &k| {
+                    let k = k as usize;
+                    merge(&b, &(x[k].inf(&p[k]), x[k].sup(&p[k])))
+                });
+                let reach = (b.0.add_scalar(-skin), b.1.add_scalar(skin));
+                for i in 0..rest.len() {
+                    let facing = vertex_normal[i].dot(&normal[t]) < 0.0;
+                    let hull = (x[i].inf(&p[i]), x[i].sup(&p[i]));
+                    if facing && !corners.contains(&(i as u32)) && overlap(&hull, &reach) {
+                        needed += 1;
+                        assert_eq!(visits[i * boundary.len() + t], 1, "pair {i}, {t} missed");
+                    }
+                }
+            }
+            // The flattened sphere's caps face each other within the skin: the test has
+            // teeth only if such pairs exist.
+            assert!(
+                squash > 0.02 || needed > 1000,
+                "{needed} pairs at squash {squash}"
+            );
+            let visited = visits.iter().filter(|&&v| v > 0).count();
+            assert!(
+                visited < boundary.len() * rest.len() / 10,
+                "the tree culls little: {visited} pairs"
+            );
+        }
+    }
+
+    /// Cones: a union holds both, and two cones said never to face hold no pair of vectors
+    /// more than 90° apart (random cones against random members).
+    #[test]
+    fn cone_unions_hold_both_and_never_faces_is_conservative() {
+        let mut seed = 5u64;
+        let mut random = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        let mut members = |axis: Vec3, spread: Real| -> Vec<Vec3> {
+            (0..20)
+                .map(|_| (axis + Vec3::new(random(), random(), random()) * spread).normalize())
+                .collect()
+        };
+        let mut skipped = 0;
+        for case in 0..400 {
+            let spread = [0.05, 0.3, 1.0, 3.0][case % 4];
+            let a_axis = Vec3::new(1.0, 0.1 * (case % 7) as Real, 0.0).normalize();
+            let b_axis = Vec3::new((case % 5) as Real * 0.2 - 0.3, 1.0, 0.2).normalize();
+            let (a, b) = (members(a_axis, spread), members(b_axis, spread));
+            let (ca, cb) = (Cone::of(a.iter().copied()), Cone::of(b.iter().copied()));
+            let u = ca.union(&cb);
+            for v in a.iter().chain(&b) {
+                assert!(u.cos == -1.0 || v.dot(&u.axis) >= u.cos - 1e-12);
+            }
+            if ca.never_faces(&cb) {
+                skipped += 1;
+                assert!(a.iter().all(|v| b.iter().all(|w| v.dot(w) > 0.0)));
+            }
+        }
+        assert!(skipped > 50, "only {skipped} cases skipped");
+    }
+}
