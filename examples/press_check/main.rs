@@ -4,12 +4,13 @@
 //!
 //! ```text
 //! cargo run --release --example press_check -- [--radii 1,2.5,5,10] [--sides +x,-x,+z,-z]
-//!     [--depth 0.03] [--hold 0.5] [--scale 0.03] [--crushed-substeps N] MESH...
+//!     [--depth 0.03] [--hold 0.5] [--scale 0.03] [--crushed-substeps N] [--self-contact] MESH...
 //! ```
 //! `MESH`: a mesh file (TetGen `.node`/`.ele` base, gmsh `.msh`, legacy `.vtk`) or the name of
 //! one in `data/meshes`; `--scale` its unit in metres (0.03: the data meshes' organs, 12–21 cm
 //! across); `--radii` the sphere radii (mm); `--depth` metres past first contact; `--hold`
-//! seconds. Exits non-zero when a judged press misses the goal.
+//! seconds; `--self-contact` switches the surface self-contact on (`Settings::self_contact`).
+//! Exits non-zero when a judged press misses the goal.
 
 mod press;
 
@@ -50,6 +51,7 @@ fn run() -> Res<()> {
     let scale: Real = option(&args, "--scale", 0.03)?;
     let mut settings = Settings::default();
     settings.crushed_substeps = option(&args, "--crushed-substeps", settings.crushed_substeps)?;
+    settings.self_contact = args.iter().any(|a| a == "--self-contact");
     let valued = [
         "--radii",
         "--sides",

@@ -676,16 +676,7 @@ fn barycentric(q: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> [Real; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Numbers uniform in [-0.5, 0.5) from a linear congruential generator started at `seed`.
-    fn uniform(mut seed: u64) -> impl FnMut() -> Real {
-        move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
-        }
-    }
+    use crate::kernels::math::uniform;
 
     /// The path box's quick test keeps every triangle the exact test keeps, and still turns
     /// away most of those far from the path: random slivers and segments, near and far.

@@ -29,3 +29,15 @@ pub(crate) fn tet_volume_gradient(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> [Ve
     let gd = (b - a).cross(&(c - a)) / 6.0;
     [-(gb + gc + gd), gb, gc, gd]
 }
+
+/// Numbers uniform in [−0.5, 0.5) (dimensionless) from a linear congruential generator started
+/// at `seed`: the unit tests' reproducible randomness.
+#[cfg(test)]
+pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> Real {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
+    }
+}

@@ -630,13 +630,8 @@ mod tests {
 
     /// A jittered 5×4×4 block of points (m), with a deterministic pseudo-random jitter.
     fn jittered_block() -> Vec<Vec3> {
-        let mut seed = 12345_u64;
-        let mut jitter = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as Real / (1u64 << 53) as Real - 0.5) * 0.3
-        };
+        let mut random = crate::kernels::math::uniform(12345);
+        let mut jitter = move || random() * 0.3;
         let mut points = Vec::new();
         for i in 0..5 {
             for j in 0..4 {

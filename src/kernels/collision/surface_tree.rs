@@ -410,6 +410,7 @@ impl TreeFit {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernels::math::uniform;
 
     /// A closed sphere of radius 1 (m): `rings` rings of `segments` vertices between two poles,
     /// triangles wound outwards.
@@ -463,13 +464,7 @@ mod tests {
     fn visits_every_pair_the_exact_test_could_keep_exactly_once() {
         let (rest, boundary) = sphere(24, 40);
         let tree = SurfaceTree::new(&rest, &boundary);
-        let mut seed = 11u64;
-        let mut random = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
-        };
+        let mut random = uniform(11);
         for squash in [1.0, 0.3, 0.05, 0.01] {
             let mut jitter = || Vec3::new(random(), random(), random()) * 0.004;
             let x: Vec<Vec3> = (rest.iter())
@@ -520,13 +515,7 @@ mod tests {
     /// more than 90° apart (random cones against random members).
     #[test]
     fn cone_unions_hold_both_and_never_faces_is_conservative() {
-        let mut seed = 5u64;
-        let mut random = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as Real / (1u64 << 53) as Real - 0.5
-        };
+        let mut random = uniform(5);
         let mut members = |axis: Vec3, spread: Real| -> Vec<Vec3> {
             (0..20)
                 .map(|_| (axis + Vec3::new(random(), random(), random()) * spread).normalize())
