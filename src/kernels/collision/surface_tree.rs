@@ -7,7 +7,7 @@
 //! boundary vertex belongs to one leaf, the first (in the tree's order) with a triangle at it,
 //! so that a subtree holds a run of the triangles and a run of the vertices.
 //!
-//! Every pass refits it ([`SurfaceTree::refit`]): per node the box of its triangles' corners at
+//! Every pass refits it ([`TreeFit::refit`]): per node the box of its triangles' corners at
 //! the start of the substep and at the predicted positions, grown by the contact skin, the box
 //! of its vertices at both, and the cones of its triangles' unit normals and of its vertices'
 //! unit normals (an axis and a half-angle). A vertex and a triangle can only be in contact when
@@ -19,7 +19,7 @@
 //! cone test (a patch of surface that turns by less than 45° everywhere cannot touch itself).
 //! Where the surface is far from itself and smooth, that leaves a refit and a few node tests.
 //!
-//! [`SurfaceTree::for_each_candidate`] visits the pairs the tests leave, leaf by leaf, in an
+//! [`TreeFit::for_each_candidate`] visits the pairs the tests leave, leaf by leaf, in an
 //! order fixed by the tree and the positions: the same pairs in the same order for any thread
 //! count and after a saved state is restored.
 
@@ -35,7 +35,7 @@ pub(crate) const LEAF_TRIANGLES: usize = 4;
 const FACING_MARGIN: Real = 1.0e-9;
 
 /// A node: a run `tris` of the tree's triangle order and a run `verts` of its vertex order; an
-/// inner node's children follow it (`left` is the next node).
+/// inner node's left child is the next node.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Node {
     tris: (u32, u32),
