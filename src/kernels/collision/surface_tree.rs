@@ -297,11 +297,11 @@ impl TreeFit {
         }
     }
 
-    /// Refit the boxes and cones of `tree` (see the module documentation) to the positions `x` at the
-    /// substep's start and `p` predicted (m), the triangles' unit normals `normal` (per boundary
-    /// triangle, zero for a degenerate one) and the vertices' unit normals `vertex_normal` (per
-    /// particle, zero for a vertex that faces nothing), the triangles' boxes grown by `skin` (m).
-    /// Needs [`TreeFit::reserve`] for `tree`.
+    /// Refit the boxes and cones of `tree` (see the module documentation) to the positions `x`
+    /// at the substep's start and `p` predicted (m), the triangles' unit normals `normal` (per
+    /// boundary triangle, zero for a degenerate one) and the vertices' unit normals
+    /// `vertex_normal` (per particle, zero for a vertex that faces nothing), the triangles'
+    /// boxes grown by `skin` (m). Needs [`TreeFit::reserve`] for `tree`.
     pub(crate) fn refit(
         &mut self,
         tree: &SurfaceTree,
