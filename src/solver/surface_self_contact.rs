@@ -42,16 +42,18 @@
 //! same way.
 //!
 //! Broad phase: the body's [`SurfaceTree`](crate::kernels::collision::surface_tree), a
-//! bounding-volume hierarchy of its boundary triangles made at rest, refitted every pass to
-//! the boxes of the positions at the substep's start and the predicted ones (the triangles'
-//! grown by `s`, so that a vertex that crossed a triangle within the substep meets its box)
-//! and to the cones of the unit normals. Subtrees whose boxes miss each other, or whose
-//! normals cannot face each other (condition 2), are skipped whole; within a pair of leaves a
-//! vertex is skipped by its own box and normal. It costs a pass over the boundary triangles
-//! (normals), a refit of the tree and its traversal. Everything runs on the calling thread in
-//! the tree's order: the same bits for any thread count.
+//! bounding-volume hierarchy of its boundary triangles made at rest, with the boxes of the
+//! positions at the substep's start and the predicted ones (the triangles' grown by `s`, so that
+//! a vertex that crossed a triangle within the substep meets its box) and the cones of the unit
+//! normals (condition 2). Its pairs are kept from pass to pass while the surface moves and turns
+//! little ([`SurfacePairs`](crate::kernels::collision::surface_pairs::SurfacePairs), one per body
+//! in its step scratch) and filtered every pass by the boxes and normals; the pass then costs the
+//! normals, a scan of the boundary's motion and the exact tests, and a build of the pairs when
+//! the surface moved too far. Everything runs on the calling thread, the pairs in (vertex,
+//! triangle) order: the same bits for any thread count and whenever the pairs were built.
 
 use crate::interaction::surface_contact::MAX_CORNER_SHARE;
+use crate::kernels::collision::surface_pairs::SurfaceMotion;
 use crate::kernels::collision::surface_tree::TreeFit;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
@@ -93,6 +95,13 @@ impl SelfContactScratch {
     }
 }
 
+/// The sizes the self-contact's pairs are made for on `model` (`SurfacePairs::reserve`): its
+/// particles, boundary vertices and boundary triangles.
+pub(crate) fn self_contact_sizes(model: &BodyModel) -> (usize, usize, usize) {
+    let vertices = model.boundary_vertices.len();
+    (model.particle_count(), vertices, model.boundary.len())
+}
+
 /// One Gauss–Seidel pass of `body`'s surface self-contacts (see the module documentation) on
 /// the predicted positions in `step`, with static and kinetic friction coefficients
 /// `(mu_s, mu_k)` (dimensionless), a vertex already within the skin at the substep's start
@@ -110,9 +119,10 @@ pub(crate) fn project_self_contacts(
         return;
     }
     scratch.reserve(model);
+    (step.self_contact_pairs).reserve(self_contact_sizes(model));
     let skin = SELF_CONTACT_SKIN * model.particle_radius;
     let (x, w, rest) = (&body.state.x, &body.inv_mass, &model.rest);
-    let p = &mut step.p;
+    let p = &step.p;
     let SelfContactScratch {
         fit,
         normal,
@@ -134,27 +144,41 @@ pub(crate) fn project_self_contacts(
         // A zero normal faces no triangle (condition 2).
         *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
     }
-    let tree = &model.boundary_tree;
-    fit.refit(tree, boundary, (x, p), (normal, vertex_normal), skin);
-    fit.for_each_candidate(tree, p, vertex_normal, |i, t, p| {
+    let motion = SurfaceMotion {
+        x,
+        p,
+        vertex_normal,
+        normal,
+    };
+    let far_at_rest = |i: usize, t: usize| {
+        let [ra, rb, rc] = boundary[t].map(|k| Point::from(rest[k as usize]));
+        let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
+        at_rest >= skin
+    };
+    let pairs = step.self_contact_pairs.live(
+        (&model.boundary_tree, fit),
+        (boundary, &model.boundary_vertices),
+        &motion,
+        skin,
+    );
+    let p = &mut step.p;
+    for &(i, t) in pairs {
+        let (i, t) = (i as usize, t as usize);
         let n = normal[t];
-        if boundary[t].contains(&(i as u32)) || n.dot(&vertex_normal[i]) >= 0.0 {
-            return;
-        }
         let corners = boundary[t].map(|k| k as usize);
         let [a, b, c] = corners.map(|k| p[k]);
         let height = (p[i] - a).dot(&n);
         if height >= skin {
-            return;
+            continue;
         }
         let [a0, b0, c0] = corners.map(|k| x[k]);
         let n0 = (b0 - a0).cross(&(c0 - a0)).try_normalize(0.0).unwrap_or(n);
         let start = (x[i] - a0).dot(&n0);
         if start < 0.0 || n0.dot(&n) <= 0.0 {
-            return;
+            continue;
         }
         let Some(weights) = contact_weights(&p[i], [a, b, c], skin) else {
-            return;
+            continue;
         };
         if height < 0.0 {
             // Crossed the plane in this substep: only through the triangle (or within the
@@ -162,19 +186,17 @@ pub(crate) fn project_self_contacts(
             let at = start / (start - height);
             let then = |k: usize| x[k] + (p[k] - x[k]) * at;
             if contact_weights(&then(i), corners.map(then), skin).is_none() {
-                return;
+                continue;
             }
         }
         // Stop a crossing whole; lift a vertex that was within the skin at the start by at
         // most `max_correction`.
         let depth = skin.min(start + max_correction) - height;
         if depth <= 0.0 {
-            return;
+            continue;
         }
-        let [ra, rb, rc] = corners.map(|k| Point::from(rest[k]));
-        let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
-        if at_rest < skin {
-            return;
+        if !far_at_rest(i, t) {
+            continue;
         }
         let wk = corners.map(|k| w[k]);
         let total = w[i]
@@ -182,7 +204,7 @@ pub(crate) fn project_self_contacts(
                 .map(|k| weights[k] * weights[k] * wk[k])
                 .sum::<Real>();
         if total <= 0.0 {
-            return;
+            continue;
         }
         let own = w[i] / total;
         let shares = [0, 1, 2].map(|k| (weights[k] * wk[k] / total).min(MAX_CORNER_SHARE));
@@ -198,7 +220,7 @@ pub(crate) fn project_self_contacts(
             .sum();
         let relative = (p[i] - x[i]) - foot_motion;
         spread(p, friction_correction(&relative, &n, depth, mu_s, mu_k));
-    });
+    }
 }
 
 /// Where the contact of the point `q` with the triangle `a b c` (m) acts on the triangle, as

@@ -3,6 +3,7 @@
 //! when bodies are added and reused, so that a step allocates nothing.
 
 use crate::kernels::collision::hash_grid::HashGrid;
+use crate::kernels::collision::surface_pairs::SurfacePairs;
 use crate::kernels::math::{Real, Vec3};
 use crate::kernels::tet_elasticity::TetShares;
 use crate::model::body_model::BodyModel;
@@ -11,9 +12,11 @@ use crate::scene::body::Body;
 use crate::scene::particles::ParticleView;
 use crate::scene::WorldState;
 use crate::solver::divergence_check::ParticleScan;
+use crate::solver::surface_self_contact::self_contact_sizes;
 use crate::solver::{SelfContactScratch, SurfaceScratch};
 
-/// A body's working memory of a step; nothing in it outlives a substep.
+/// A body's working memory of a step; nothing in it outlives a substep but the self-contact's
+/// built pairs, which never change a result (`kernels::collision::surface_pairs`).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct StepScratch {
     /// Predicted positions of the current substep (m).
@@ -55,6 +58,9 @@ pub(crate) struct StepScratch {
     pub(crate) dashpot_undamped: Vec<bool>,
     /// The particle half of the divergence check, made in the step's last update pass.
     pub(crate) scan: ParticleScan,
+    /// The surface self-contact's candidate pairs, kept while the surface moves little (sized
+    /// by the first pass with self-contact on).
+    pub(crate) self_contact_pairs: SurfacePairs,
 }
 
 impl StepScratch {
@@ -74,6 +80,7 @@ impl StepScratch {
             dashpot_undamped: vec![false; n],
             dashpot_impulse: vec![Vec3::zeros(); model.tet_dashpots.slot_count()],
             scan: ParticleScan::EMPTY,
+            self_contact_pairs: SurfacePairs::default(),
         };
         scratch.size_kept(model, threads);
         scratch
@@ -146,6 +153,7 @@ impl Workspace {
     pub(crate) fn fit_boundaries<'a>(&mut self, models: impl Iterator<Item = &'a BodyModel>) {
         for (scratch, model) in self.bodies.iter_mut().zip(models) {
             self.self_contact.reserve(model);
+            (scratch.self_contact_pairs).forget(self_contact_sizes(model));
             scratch.tet_shares.refit(&model.tet_elements);
         }
     }

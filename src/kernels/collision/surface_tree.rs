@@ -23,6 +23,7 @@
 //! order fixed by the tree and the positions: the same pairs in the same order for any thread
 //! count and after a saved state is restored.
 
+use crate::kernels::collision::aabb::{grow, inflated, merge, motion, overlap, Aabb, EMPTY_BOX};
 use crate::kernels::math::{Real, Vec3};
 
 /// Most triangles in a leaf (dimensionless). Smaller leaves hold tighter cones (fewer pairs
@@ -119,6 +120,25 @@ impl Cone {
         (sin >= 0.0 && self.cos > -1.0).then_some((c * self.cos - s * self.sin, sin))
     }
 
+    /// This cone with its half-angle grown by the angle whose cosine and sine are `turn`
+    /// (at most 90°): it holds every unit vector within that angle of one of its own.
+    fn widened(&self, (cos, sin): (Real, Real)) -> Cone {
+        if self.is_empty() || sin == 0.0 {
+            return *self;
+        }
+        let grown = Cone {
+            axis: self.axis,
+            cos: self.cos * cos - self.sin * sin,
+            sin: self.sin * cos + self.cos * sin,
+        };
+        // Past 180° the cone holds every vector.
+        if grown.sin < 0.0 {
+            Cone::FULL
+        } else {
+            grown
+        }
+    }
+
     /// A cone holding both.
     fn union(&self, other: &Cone) -> Cone {
         if self.is_empty() {
@@ -157,27 +177,6 @@ impl Cone {
     }
 }
 
-/// An axis-aligned box (m): lower and upper corners; [`EMPTY_BOX`] holds nothing.
-type Aabb = (Vec3, Vec3);
-
-const EMPTY_BOX: Aabb = (
-    Vec3::new(Real::INFINITY, Real::INFINITY, Real::INFINITY),
-    Vec3::new(-Real::INFINITY, -Real::INFINITY, -Real::INFINITY),
-);
-
-fn grow(b: &mut Aabb, p: &Vec3) {
-    b.0 = b.0.inf(p);
-    b.1 = b.1.sup(p);
-}
-
-fn merge(a: &Aabb, b: &Aabb) -> Aabb {
-    (a.0.inf(&b.0), a.1.sup(&b.1))
-}
-
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
-
 /// The tree's shape (see the module documentation), made from the rest positions.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct SurfaceTree {
@@ -201,6 +200,8 @@ pub(crate) struct TreeFit {
     /// Per particle, the box of its position at the substep's start and its predicted one (m;
     /// written for boundary vertices only).
     hull: Vec<Aabb>,
+    /// The cosine and sine of the angle the vertices' cones are widened by at the last refit.
+    turn: (Real, Real),
 }
 
 impl SurfaceTree {
@@ -301,18 +302,23 @@ impl TreeFit {
     /// at the substep's start and `p` predicted (m), the triangles' unit normals `normal` (per
     /// boundary triangle, zero for a degenerate one) and the vertices' unit normals
     /// `vertex_normal` (per particle, zero for a vertex that faces nothing), the triangles'
-    /// boxes grown by `skin` (m). Needs [`TreeFit::reserve`] for `tree`.
+    /// boxes grown by `reach` (m) and the vertices' cones by the angle whose cosine and sine
+    /// are `turn` (at most 90°: the pairs kept then include those whose normals could face
+    /// each other after each normal turned by half of it). Needs [`TreeFit::reserve`] for
+    /// `tree`.
     pub(crate) fn refit(
         &mut self,
         tree: &SurfaceTree,
         boundary: &[[u32; 3]],
         (x, p): (&[Vec3], &[Vec3]),
         (normal, vertex_normal): (&[Vec3], &[Vec3]),
-        skin: Real,
+        reach: Real,
+        turn: (Real, Real),
     ) {
+        self.turn = turn;
         for &k in &tree.vertices {
             let k = k as usize;
-            self.hull[k] = (x[k].inf(&p[k]), x[k].sup(&p[k]));
+            self.hull[k] = motion(&x[k], &p[k]);
         }
         let hull = &self.hull;
         for n in (0..tree.nodes.len()).rev() {
@@ -322,11 +328,12 @@ impl TreeFit {
                 let verts = &tree.vertices[node.verts.0 as usize..node.verts.1 as usize];
                 let corners = (tris.iter().flat_map(|&t| boundary[t as usize]))
                     .fold(EMPTY_BOX, |b, k| merge(&b, &hull[k as usize]));
-                self.triangle_box[n] = (corners.0.add_scalar(-skin), corners.1.add_scalar(skin));
+                self.triangle_box[n] = inflated(&corners, reach);
                 self.vertex_box[n] =
                     (verts.iter()).fold(EMPTY_BOX, |b, &k| merge(&b, &hull[k as usize]));
                 self.triangle_cone[n] = Cone::of(tris.iter().map(|&t| normal[t as usize]));
-                self.vertex_cone[n] = Cone::of(verts.iter().map(|&k| vertex_normal[k as usize]));
+                self.vertex_cone[n] =
+                    Cone::of(verts.iter().map(|&k| vertex_normal[k as usize])).widened(turn);
             } else {
                 let (l, r) = (n + 1, node.right as usize);
                 self.triangle_box[n] = merge(&self.triangle_box[l], &self.triangle_box[r]);
@@ -346,13 +353,12 @@ impl TreeFit {
     /// Call `visit(vertex, triangle)` (a particle index, an index of the boundary) for every
     /// pair of a vertex and a triangle in leaves that the last refit's boxes and cones do not
     /// keep apart (see the module documentation), leaf pair by leaf pair. A vertex is visited
-    /// with the triangles around it too: the exact test turns those away.
+    /// with the triangles around it too: the caller turns those away.
     pub(crate) fn for_each_candidate(
         &self,
         tree: &SurfaceTree,
-        p: &mut [Vec3],
         vertex_normal: &[Vec3],
-        mut visit: impl FnMut(usize, usize, &mut [Vec3]),
+        mut visit: impl FnMut(usize, usize),
     ) {
         if tree.nodes.is_empty() {
             return;
@@ -388,12 +394,14 @@ impl TreeFit {
                 for &i in verts {
                     let i = i as usize;
                     if !overlap(&self.hull[i], reach)
-                        || Cone::unit(vertex_normal[i]).never_faces(cone)
+                        || Cone::unit(vertex_normal[i])
+                            .widened(self.turn)
+                            .never_faces(cone)
                     {
                         continue;
                     }
                     for &t in tris {
-                        visit(i, t as usize, p);
+                        visit(i, t as usize);
                     }
                 }
             } else if !na.is_leaf() && (nb.is_leaf() || na.size() >= nb.size()) {
@@ -408,13 +416,13 @@ impl TreeFit {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::kernels::math::uniform;
 
     /// A closed sphere of radius 1 (m): `rings` rings of `segments` vertices between two poles,
     /// triangles wound outwards.
-    fn sphere(rings: usize, segments: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    pub(crate) fn sphere(rings: usize, segments: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let mut v = vec![Vec3::new(0.0, 0.0, 1.0)];
         for r in 1..=rings {
             let polar = std::f64::consts::PI * r as Real / (rings + 1) as Real;
@@ -439,7 +447,8 @@ mod tests {
         (v, t)
     }
 
-    fn unit_normals(p: &[Vec3], boundary: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
+    /// The unit normals of the triangles `boundary` and of the vertices at `p` (m).
+    pub(crate) fn unit_normals(p: &[Vec3], boundary: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
         let mut vertex = vec![Vec3::zeros(); p.len()];
         let triangle = (boundary.iter())
             .map(|c| {
@@ -456,28 +465,41 @@ mod tests {
     }
 
     /// Every pair the exact test could keep is visited, exactly once: a vertex facing a
-    /// triangle (normals more than 90° apart) that is not one of its corners, the box of its
-    /// two positions meeting the triangle's box at both grown by the skin. On a sphere pressed
-    /// flat between two planes until its caps nearly touch, with random jitter, so that the
-    /// caps face each other within the skin and its rim is sharp.
+    /// triangle (normals more than 90° apart, or more than 90° less the cones' widening) that
+    /// is not one of its corners, the box of its two positions meeting the triangle's box at
+    /// both grown by the reach. On a sphere pressed flat between two planes until its caps
+    /// nearly touch, with random jitter, so that the caps face each other within the skin and
+    /// its rim is sharp; unwidened and widened by 30°.
     #[test]
     fn visits_every_pair_the_exact_test_could_keep_exactly_once() {
         let (rest, boundary) = sphere(24, 40);
         let tree = SurfaceTree::new(&rest, &boundary);
         let mut random = uniform(11);
-        for squash in [1.0, 0.3, 0.05, 0.01] {
+        let turns = [0.0, 30.0_f64.to_radians()];
+        for (squash, turn) in [1.0, 0.3, 0.05, 0.01]
+            .into_iter()
+            .flat_map(|s| turns.map(|t| (s, t)))
+        {
             let mut jitter = || Vec3::new(random(), random(), random()) * 0.004;
             let x: Vec<Vec3> = (rest.iter())
                 .map(|r| Vec3::new(r.x, r.y, r.z * squash) + jitter())
                 .collect();
-            let mut p: Vec<Vec3> = x.iter().map(|x| x + jitter()).collect();
+            let p: Vec<Vec3> = x.iter().map(|x| x + jitter()).collect();
             let (normal, vertex_normal) = unit_normals(&p, &boundary);
             let skin = 0.02;
             let mut fit = TreeFit::default();
             fit.reserve(&tree, rest.len());
-            fit.refit(&tree, &boundary, (&x, &p), (&normal, &vertex_normal), skin);
+            let normals = (normal.as_slice(), vertex_normal.as_slice());
+            fit.refit(
+                &tree,
+                &boundary,
+                (&x, &p),
+                normals,
+                skin,
+                (turn.cos(), turn.sin()),
+            );
             let mut visits = vec![0u8; rest.len() * boundary.len()];
-            fit.for_each_candidate(&tree, &mut p, &vertex_normal, |i, t, _| {
+            fit.for_each_candidate(&tree, &vertex_normal, |i, t| {
                 visits[i * boundary.len() + t] += 1;
             });
             assert!(visits.iter().all(|&v| v <= 1), "a pair visited twice");
@@ -485,12 +507,12 @@ mod tests {
             for (t, corners) in boundary.iter().enumerate() {
                 let b = corners.iter().fold(EMPTY_BOX, |b, &k| {
                     let k = k as usize;
-                    merge(&b, &(x[k].inf(&p[k]), x[k].sup(&p[k])))
+                    merge(&b, &motion(&x[k], &p[k]))
                 });
-                let reach = (b.0.add_scalar(-skin), b.1.add_scalar(skin));
+                let reach = inflated(&b, skin);
                 for i in 0..rest.len() {
-                    let facing = vertex_normal[i].dot(&normal[t]) < 0.0;
-                    let hull = (x[i].inf(&p[i]), x[i].sup(&p[i]));
+                    let facing = vertex_normal[i].dot(&normal[t]) < turn.sin();
+                    let hull = motion(&x[i], &p[i]);
                     if facing && !corners.contains(&(i as u32)) && overlap(&hull, &reach) {
                         needed += 1;
                         assert_eq!(visits[i * boundary.len() + t], 1, "pair {i}, {t} missed");
