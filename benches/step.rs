@@ -7,6 +7,7 @@
 //!                             [--scene haptic|pypbd] [--threads N] [--csv PATH]
 //!                             [--times PATH] [--particles] [--tet-volumes] [--paper]
 //!                             [--self-contact] [--damping S] [--crushed-substeps N] [--profile]
+//!                             [--settled]
 //! ```
 //! `--csv` writes the table; `--times` every timed step's time (ms), in order, one row a step.
 //! Scenes:
@@ -27,6 +28,9 @@
 //! (`Settings::crushed_substeps`);
 //! `--profile` prints each stage's mean wall time per timed step (`World::step_profile`; the
 //! clock reads add well under a microsecond a step).
+//! `--settled` starts each organ at its static equilibrium under gravity (`World::settle`, as a
+//! trainer does on loading) instead of at its rest shape, so that it does not sway in the timed
+//! steps.
 //!
 //! Besides the meshes, `three_organs` is a multi-organ scene: liver_4k hanging, kidney_gmsh
 //! under it (touching it, held at its bottom 10%) and liver_1k6 beside it (touching on the −x
@@ -218,12 +222,15 @@ fn run(
     name: &str,
     scene: Scene,
     probe: bool,
-    (steps, profile): (usize, bool),
+    (steps, profile, settled): (usize, bool, bool),
     settings: &Settings,
 ) -> Row {
     let live0 = LIVE.load(Ordering::Relaxed);
     let mut world = World::new(settings.clone()).unwrap();
     let (bodies, lo, hi) = add_organs(&mut world, name, scene);
+    if settled {
+        world.settle().unwrap();
+    }
     let top = hi.y - scene.fixed_fraction * (hi.y - lo.y);
     let organ_nodes: Vec<Vec3> = world.body(bodies[0]).unwrap().rest_positions().to_vec();
     let bytes = LIVE.load(Ordering::Relaxed) - live0;
@@ -331,6 +338,7 @@ fn main() {
     let mut damping_stiffness = Settings::default().damping_stiffness;
     let mut crushed_substeps = Settings::default().crushed_substeps;
     let mut profile = false;
+    let mut settled = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -365,6 +373,7 @@ fn main() {
                     .expect("a number of substeps")
             }
             "--profile" => profile = true,
+            "--settled" => settled = true,
             "--bench" => {}
             other => panic!("unknown argument {other}"),
         }
@@ -394,7 +403,7 @@ fn main() {
                 m,
                 scene(&scene_name),
                 probe,
-                (steps, profile),
+                (steps, profile, settled),
                 &Settings {
                     threads,
                     volume_scheme,

@@ -150,11 +150,6 @@ pub(crate) fn project_self_contacts(
         vertex_normal,
         normal,
     };
-    let far_at_rest = |i: usize, t: usize| {
-        let [ra, rb, rc] = boundary[t].map(|k| Point::from(rest[k as usize]));
-        let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
-        at_rest >= skin
-    };
     let pairs = step.self_contact_pairs.live(
         (&model.boundary_tree, fit),
         (boundary, &model.boundary_vertices),
@@ -195,7 +190,9 @@ pub(crate) fn project_self_contacts(
         if depth <= 0.0 {
             continue;
         }
-        if !far_at_rest(i, t) {
+        let [ra, rb, rc] = corners.map(|k| Point::from(rest[k]));
+        let at_rest = Triangle::new(ra, rb, rc).distance_to_local_point(&rest[i].into(), true);
+        if at_rest < skin {
             continue;
         }
         let wk = corners.map(|k| w[k]);

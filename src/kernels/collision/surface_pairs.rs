@@ -112,8 +112,8 @@ impl SurfacePairs {
     /// The live pairs of a pass over the boundary triangles `boundary` (corner particle
     /// indices) and the boundary vertices `vertices` of the body of `tree`, at `motion`, with
     /// the contact skin `skin` (m) (see the module documentation). Builds with `fit` when the
-    /// surface moved or turned too far since the last build. Needs [`SurfacePairs::reserve`] for the body and
-    /// [`TreeFit::reserve`] for `tree`.
+    /// surface moved or turned too far since the last build. Needs [`SurfacePairs::reserve`]
+    /// for the body and [`TreeFit::reserve`] for `tree`.
     pub(crate) fn live(
         &mut self,
         (tree, fit): (&SurfaceTree, &mut TreeFit),
