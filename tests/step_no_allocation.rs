@@ -63,6 +63,7 @@ fn steps_after_the_first_do_not_allocate() {
         (exact, 2, DualCells, Tetrahedra, false, 1),
         (exact, 1, DualCells, Tetrahedra, false, 2),
         (exact, 1, per_tet, PointBased, true, 1),
+        (exact, 2, DualCells, Tetrahedra, true, 1),
     ] {
         let settings = Settings {
             contact_mode: mode,

@@ -330,6 +330,7 @@ impl Pipeline {
                         scratch,
                         friction,
                         scene.settings.max_depenetration_speed * h,
+                        &self.pool,
                     );
                 }
                 clock = self.profiler.charge(Stage::SelfContact, clock);

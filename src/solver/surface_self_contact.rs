@@ -49,14 +49,16 @@
 //! little ([`SurfacePairs`](crate::kernels::collision::surface_pairs::SurfacePairs), one per body
 //! in its step scratch) and filtered every pass by the boxes and normals; the pass then costs the
 //! normals, a scan of the boundary's motion and the exact tests, and a build of the pairs when
-//! the surface moved too far. Everything runs on the calling thread, the pairs in (vertex,
-//! triangle) order: the same bits for any thread count and whenever the pairs were built.
+//! the surface moved too far (its traversal split over the pool's threads, the pairs found
+//! sorted). The projections run on the calling thread, the pairs in (vertex, triangle) order:
+//! the same bits for any thread count and whenever the pairs were built.
 
 use crate::interaction::surface_contact::MAX_CORNER_SHARE;
 use crate::kernels::collision::surface_pairs::SurfaceMotion;
 use crate::kernels::collision::surface_tree::TreeFit;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::Pool;
 use crate::model::body_model::BodyModel;
 use crate::scene::body::Body;
 use crate::solver::StepScratch;
@@ -105,13 +107,14 @@ pub(crate) fn self_contact_sizes(model: &BodyModel) -> (usize, usize, usize) {
 /// One Gauss–Seidel pass of `body`'s surface self-contacts (see the module documentation) on
 /// the predicted positions in `step`, with static and kinetic friction coefficients
 /// `(mu_s, mu_k)` (dimensionless), a vertex already within the skin at the substep's start
-/// lifted by at most `max_correction` (m).
+/// lifted by at most `max_correction` (m); a build of the pairs on the threads of `pool`.
 pub(crate) fn project_self_contacts(
     scratch: &mut SelfContactScratch,
     body: &Body,
     step: &mut StepScratch,
     (mu_s, mu_k): (Real, Real),
     max_correction: Real,
+    pool: &Pool,
 ) {
     let model = &*body.model;
     let boundary = &model.boundary;
@@ -119,7 +122,7 @@ pub(crate) fn project_self_contacts(
         return;
     }
     scratch.reserve(model);
-    (step.self_contact_pairs).reserve(self_contact_sizes(model));
+    (step.self_contact_pairs).reserve(self_contact_sizes(model), pool.threads());
     let skin = SELF_CONTACT_SKIN * model.particle_radius;
     let (x, w, rest) = (&body.state.x, &body.inv_mass, &model.rest);
     let p = &step.p;
@@ -151,7 +154,7 @@ pub(crate) fn project_self_contacts(
         normal,
     };
     let pairs = step.self_contact_pairs.live(
-        (&model.boundary_tree, fit),
+        (&model.boundary_tree, fit, pool),
         (boundary, &model.boundary_vertices),
         &motion,
         skin,

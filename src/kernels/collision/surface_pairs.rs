@@ -17,7 +17,9 @@
 //! normal turned by more than `θ` (an angle between two normals then shrank by at most `2θ`),
 //! every live pair is among the built ones. So a pass checks that (a scan of the boundary),
 //! builds again when it does not hold, and filters the built pairs by the live conditions, in
-//! the order of their (vertex, triangle) indices.
+//! the order of their (vertex, triangle) indices. On several threads a build splits the tree's
+//! traversal into node pairs dealt round the threads ([`TreeFit::seeds`]); sorted, its pairs do
+//! not depend on the split.
 //!
 //! The live pairs and their order do not depend on when the last build was: the same bits as
 //! building every pass, whatever happened since (a restored state, a pose set, a thread count).
@@ -26,6 +28,7 @@
 use crate::kernels::collision::aabb::{grow, inflated, merge, overlap, Aabb, EMPTY_BOX};
 use crate::kernels::collision::surface_tree::{SurfaceTree, TreeFit};
 use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::{Pool, SharedSlice};
 
 /// The margin `m` of a build, in contact skins (dimensionless): how far apart the surface's
 /// displacements may spread before the next build. A larger margin keeps more pairs and makes
@@ -36,6 +39,10 @@ const REUSE_MARGIN: Real = 1.0;
 /// The angle `θ` each unit normal may turn before the next build (radians, 5°); a cost
 /// setting as [`REUSE_MARGIN`] is.
 const REUSE_TURN: Real = std::f64::consts::PI / 36.0;
+
+/// Seeds of the traversal a build deals to each thread on several (dimensionless): enough to
+/// even out the shares' work.
+const SEEDS_PER_THREAD: usize = 8;
 
 /// Kept pairs a build reserves room for, per boundary vertex (dimensionless): more are taken
 /// when a fold needs them (an allocation in that step, kept for the next).
@@ -48,6 +55,8 @@ pub(crate) struct SurfacePairs {
     built: Vec<(u32, u32)>,
     /// The live pairs of the last pass, in the same order.
     live: Vec<(u32, u32)>,
+    /// Per thread of a build on several, the pairs its share of the traversal found.
+    shares: Vec<Vec<(u32, u32)>>,
     /// Per particle, its positions at the substep's start and predicted at the build (m), and
     /// its unit normal then (written for boundary vertices only).
     anchor_x: Vec<Vec3>,
@@ -73,8 +82,13 @@ pub(crate) struct SurfaceMotion<'a> {
 
 impl SurfacePairs {
     /// Make room for a body of `particles` particles, `vertices` boundary vertices and
-    /// `triangles` boundary triangles (allocates only when it holds fewer).
-    pub(crate) fn reserve(&mut self, (particles, vertices, triangles): (usize, usize, usize)) {
+    /// `triangles` boundary triangles, built on `threads` threads (allocates only when it holds
+    /// fewer).
+    pub(crate) fn reserve(
+        &mut self,
+        (particles, vertices, triangles): (usize, usize, usize),
+        threads: usize,
+    ) {
         for anchor in [
             &mut self.anchor_x,
             &mut self.anchor_p,
@@ -88,18 +102,30 @@ impl SurfacePairs {
             self.anchor_normal.resize(triangles, Vec3::zeros());
         }
         let pairs = RESERVED_PER_VERTEX * vertices;
-        for list in [&mut self.built, &mut self.live] {
-            list.reserve(pairs.saturating_sub(list.len()));
+        if threads > 1 && self.shares.len() < threads {
+            self.shares.resize(threads, Vec::new());
+        }
+        // A share's list: twice an even share of the pairs.
+        let share = match threads {
+            1 => 0,
+            _ => 2 * pairs / threads,
+        };
+        let lists = [&mut self.built, &mut self.live].into_iter();
+        for (list, room) in lists
+            .map(|l| (l, pairs))
+            .chain(self.shares.iter_mut().map(|l| (l, share)))
+        {
+            list.reserve(room.saturating_sub(list.len()));
         }
     }
 
     /// Drop the built pairs: the boundary's triangles changed, to `triangles` triangles over
     /// `vertices` of `particles` particles. When the pairs were in use, make room for those
     /// (so that the next pass allocates nothing).
-    pub(crate) fn forget(&mut self, (particles, vertices, triangles): (usize, usize, usize)) {
+    pub(crate) fn forget(&mut self, sizes: (usize, usize, usize)) {
         self.valid = false;
         if !self.anchor_x.is_empty() {
-            self.reserve((particles, vertices, triangles));
+            self.reserve(sizes, self.shares.len().max(1));
         }
     }
 
@@ -112,11 +138,11 @@ impl SurfacePairs {
     /// The live pairs of a pass over the boundary triangles `boundary` (corner particle
     /// indices) and the boundary vertices `vertices` of the body of `tree`, at `motion`, with
     /// the contact skin `skin` (m) (see the module documentation). Builds with `fit` when the
-    /// surface moved or turned too far since the last build. Needs [`SurfacePairs::reserve`]
-    /// for the body and [`TreeFit::reserve`] for `tree`.
+    /// surface moved or turned too far since the last build, on the threads of `pool`. Needs
+    /// [`SurfacePairs::reserve`] for the body and the pool and [`TreeFit::reserve`] for `tree`.
     pub(crate) fn live(
         &mut self,
-        (tree, fit): (&SurfaceTree, &mut TreeFit),
+        (tree, fit, pool): (&SurfaceTree, &mut TreeFit, &Pool),
         (boundary, vertices): (&[[u32; 3]], &[u32]),
         motion: &SurfaceMotion,
         skin: Real,
@@ -124,7 +150,7 @@ impl SurfacePairs {
         let margin = REUSE_MARGIN * skin;
         if !self.valid || self.moved((boundary, vertices), motion, margin) {
             let reach = skin + margin;
-            self.build((tree, fit), (boundary, vertices), motion, reach);
+            self.build((tree, fit, pool), (boundary, vertices), motion, reach);
         }
         self.live.clear();
         for &(i, t) in &self.built {
@@ -177,7 +203,7 @@ impl SurfacePairs {
     /// `90° − 2θ` apart, sorted, and anchor them at `motion`.
     fn build(
         &mut self,
-        (tree, fit): (&SurfaceTree, &mut TreeFit),
+        (tree, fit, pool): (&SurfaceTree, &mut TreeFit, &Pool),
         (boundary, vertices): (&[[u32; 3]], &[u32]),
         motion: &SurfaceMotion,
         reach: Real,
@@ -195,20 +221,46 @@ impl SurfacePairs {
         );
         // Above sin 2θ by far more than rounding.
         let facing = turn.sin() + 1.0e-9;
-        let built = &mut self.built;
-        built.clear();
-        fit.for_each_candidate(tree, motion.vertex_normal, |i, t| {
+        let kept = |i: usize, t: usize| {
             let corners = boundary[t];
-            if !corners.contains(&(i as u32))
+            !corners.contains(&(i as u32))
                 && motion.vertex_normal[i].dot(&motion.normal[t]) < facing
                 && overlap(
                     &motion_box(motion, i),
                     &triangle_box(motion, corners, reach),
                 )
-            {
-                built.push((i as u32, t as u32));
+        };
+        let built = &mut self.built;
+        built.clear();
+        let threads = pool.threads();
+        let fit = &*fit;
+        if threads == 1 {
+            fit.for_each_candidate(tree, (0, 0), motion.vertex_normal, |i, t| {
+                if kept(i, t) {
+                    built.push((i as u32, t as u32));
+                }
+            });
+        } else {
+            // The traversal split into seeds dealt round the threads, each into its own list;
+            // sorted below, the pairs do not depend on the split.
+            let (seeds, count) = fit.seeds(tree, SEEDS_PER_THREAD * threads);
+            let lists = SharedSlice::new(&mut self.shares[..threads]);
+            pool.run(&|share| {
+                // SAFETY: each share writes its own list.
+                let list = unsafe { lists.element(share) };
+                list.clear();
+                for &seed in seeds[..count].iter().skip(share).step_by(threads) {
+                    fit.for_each_candidate(tree, seed, motion.vertex_normal, |i, t| {
+                        if kept(i, t) {
+                            list.push((i as u32, t as u32));
+                        }
+                    });
+                }
+            });
+            for list in &self.shares[..threads] {
+                built.extend_from_slice(list);
             }
-        });
+        }
         built.sort_unstable();
         for &k in vertices {
             let k = k as usize;
@@ -244,8 +296,8 @@ mod tests {
     const SKIN: Real = 0.02;
 
     /// Follow the surface `boundary` through the positions `frames` (one a pass; a pass's
-    /// start is the frame before), asserting that the pairs kept from build to build are those
-    /// of a build every pass, in the same order. Returns per pass whether it built and how many
+    /// start is the frame before), asserting that the pairs kept from build to build (on one
+    /// thread) are those of a build every pass (on two), in the same order. Returns per pass whether it built and how many
     /// pairs were live.
     fn follow(boundary: &[[u32; 3]], frames: &[Vec<Vec3>]) -> Vec<(bool, usize)> {
         let n = frames[0].len();
@@ -254,7 +306,9 @@ mod tests {
         let mut fits = [TreeFit::default(), TreeFit::default()];
         fits.iter_mut().for_each(|f| f.reserve(&tree, n));
         let mut kept = SurfacePairs::default();
-        kept.reserve((n, n, boundary.len()));
+        kept.reserve((n, n, boundary.len()), 1);
+        // Built every pass on two threads, kept on one.
+        let (one, two) = (Pool::new(1), Pool::new(2));
         let mut passes = Vec::new();
         for (pass, pair) in frames.windows(2).enumerate() {
             let (x, p) = (&pair[0], &pair[1]);
@@ -267,10 +321,11 @@ mod tests {
             };
             let [a, b] = &mut fits;
             let builds = kept.builds();
-            let reused = (kept.live((&tree, a), (boundary, &vertices), &motion, SKIN)).to_vec();
+            let reused = kept.live((&tree, a, &one), (boundary, &vertices), &motion, SKIN);
+            let reused = reused.to_vec();
             let mut fresh = SurfacePairs::default();
-            fresh.reserve((n, n, boundary.len()));
-            let built = fresh.live((&tree, b), (boundary, &vertices), &motion, SKIN);
+            fresh.reserve((n, n, boundary.len()), 2);
+            let built = fresh.live((&tree, b, &two), (boundary, &vertices), &motion, SKIN);
             assert!(reused == *built, "pass {pass}: the kept pairs differ");
             passes.push((kept.builds() > builds, reused.len()));
         }

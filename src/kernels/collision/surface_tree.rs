@@ -19,9 +19,10 @@
 //! cone test (a patch of surface that turns by less than 45° everywhere cannot touch itself).
 //! Where the surface is far from itself and smooth, that leaves a refit and a few node tests.
 //!
-//! [`TreeFit::for_each_candidate`] visits the pairs the tests leave, leaf by leaf, in an
-//! order fixed by the tree and the positions: the same pairs in the same order for any thread
-//! count and after a saved state is restored.
+//! [`TreeFit::for_each_candidate`] visits the pairs the tests leave below a node pair, leaf by
+//! leaf, in an order fixed by the tree and the positions; [`TreeFit::seeds`] splits the whole
+//! traversal into node pairs whose traversals together visit each pair once, for several
+//! threads.
 
 use crate::kernels::collision::aabb::{grow, inflated, merge, motion, overlap, Aabb, EMPTY_BOX};
 use crate::kernels::math::{Real, Vec3};
@@ -29,6 +30,9 @@ use crate::kernels::math::{Real, Vec3};
 /// Most triangles in a leaf (dimensionless). Smaller leaves hold tighter cones (fewer pairs
 /// tested exactly) but make more nodes to refit and visit.
 pub(crate) const LEAF_TRIANGLES: usize = 4;
+
+/// Most node pairs [`TreeFit::seeds`] returns (dimensionless).
+pub(crate) const MAX_SEEDS: usize = 64;
 
 /// Least cosine (dimensionless) of the widest angle between a vertex normal and a triangle
 /// normal for a pair of nodes to be skipped: far above rounding, so that every skipped pair has
@@ -350,69 +354,120 @@ impl TreeFit {
             && !self.vertex_cone[a].never_faces(&self.triangle_cone[b])
     }
 
+    /// Node pairs to start traversals from ([`TreeFit::for_each_candidate`]) that together
+    /// visit what one from the root does, each pair once: the root's pair split breadth-first
+    /// into the pairs it descends to (those the last refit keeps apart dropped) until at least
+    /// `want` (at most [`MAX_SEEDS`] less 3) are left or only pairs of leaves. Returns them and
+    /// their count; with `want` = 1 the root alone.
+    pub(crate) fn seeds(
+        &self,
+        tree: &SurfaceTree,
+        want: usize,
+    ) -> ([(u32, u32); MAX_SEEDS], usize) {
+        let want = want.min(MAX_SEEDS - 3);
+        let mut seeds = [(0, 0); MAX_SEEDS];
+        let mut leaves = 0;
+        // Pending pairs, first in first out; a split adds at most 3, so they fit.
+        let mut ring = [(0u32, 0u32); MAX_SEEDS];
+        let (mut head, mut pending) = (0, usize::from(!tree.nodes.is_empty()));
+        while pending > 0 && leaves + pending < want {
+            let (a, b) = ring[head];
+            (head, pending) = ((head + 1) % MAX_SEEDS, pending - 1);
+            let (a, b) = (a as usize, b as usize);
+            if !self.may_touch(a, b) {
+                continue;
+            }
+            let split = descend(tree, (a, b), |x, y| {
+                ring[(head + pending) % MAX_SEEDS] = (x as u32, y as u32);
+                pending += 1;
+            });
+            if !split {
+                seeds[leaves] = (a as u32, b as u32);
+                leaves += 1;
+            }
+        }
+        for k in 0..pending {
+            seeds[leaves + k] = ring[(head + k) % MAX_SEEDS];
+        }
+        (seeds, leaves + pending)
+    }
+
     /// Call `visit(vertex, triangle)` (a particle index, an index of the boundary) for every
-    /// pair of a vertex and a triangle in leaves that the last refit's boxes and cones do not
-    /// keep apart (see the module documentation), leaf pair by leaf pair. A vertex is visited
-    /// with the triangles around it too: the caller turns those away.
+    /// pair of a vertex and a triangle in leaves below the node pair `seed` (vertices of the
+    /// first node, triangles of the second; `(0, 0)` is the whole tree against itself) that the
+    /// last refit's boxes and cones do not keep apart (see the module documentation), leaf pair
+    /// by leaf pair. A vertex is visited with the triangles around it too: the caller turns
+    /// those away.
     pub(crate) fn for_each_candidate(
         &self,
         tree: &SurfaceTree,
+        seed: (u32, u32),
         vertex_normal: &[Vec3],
         mut visit: impl FnMut(usize, usize),
     ) {
-        if tree.nodes.is_empty() {
-            return;
-        }
         // Depth-first over (vertices of a, triangles of b) node pairs; a pair with a == b is a
         // node against itself. Pending pairs: a node against itself leaves three for each
         // level it descends, a pair of nodes one for each level either descends, so at most
         // five times the depth plus one; median splits keep the depth under 32 for any `u32`
         // count of triangles.
-        let mut stack = [(0u32, 0u32); 5 * 32 + 1];
-        let mut top = 1;
+        let mut stack = [seed; 5 * 32 + 1];
+        let mut top = usize::from(!tree.nodes.is_empty());
         while top > 0 {
             top -= 1;
             let (a, b) = (stack[top].0 as usize, stack[top].1 as usize);
             if !self.may_touch(a, b) {
                 continue;
             }
-            let (na, nb) = (tree.nodes[a], tree.nodes[b]);
-            let mut push = |a: usize, b: usize| {
-                stack[top] = (a as u32, b as u32);
+            let split = descend(tree, (a, b), |x, y| {
+                stack[top] = (x as u32, y as u32);
                 top += 1;
-            };
-            if a == b && !na.is_leaf() {
-                let (l, r) = (a + 1, na.right as usize);
-                push(r, l);
-                push(l, r);
-                push(r, r);
-                push(l, l);
-            } else if na.is_leaf() && nb.is_leaf() {
-                let verts = &tree.vertices[na.verts.0 as usize..na.verts.1 as usize];
-                let tris = &tree.triangles[nb.tris.0 as usize..nb.tris.1 as usize];
-                let (reach, cone) = (&self.triangle_box[b], &self.triangle_cone[b]);
-                for &i in verts {
-                    let i = i as usize;
-                    if !overlap(&self.hull[i], reach)
-                        || Cone::unit(vertex_normal[i])
-                            .widened(self.turn)
-                            .never_faces(cone)
-                    {
-                        continue;
-                    }
-                    for &t in tris {
-                        visit(i, t as usize);
-                    }
+            });
+            if split {
+                continue;
+            }
+            let (na, nb) = (tree.nodes[a], tree.nodes[b]);
+            let verts = &tree.vertices[na.verts.0 as usize..na.verts.1 as usize];
+            let tris = &tree.triangles[nb.tris.0 as usize..nb.tris.1 as usize];
+            let (reach, cone) = (&self.triangle_box[b], &self.triangle_cone[b]);
+            for &i in verts {
+                let i = i as usize;
+                if !overlap(&self.hull[i], reach)
+                    || Cone::unit(vertex_normal[i])
+                        .widened(self.turn)
+                        .never_faces(cone)
+                {
+                    continue;
                 }
-            } else if !na.is_leaf() && (nb.is_leaf() || na.size() >= nb.size()) {
-                push(na.right as usize, b);
-                push(a + 1, b);
-            } else {
-                push(a, nb.right as usize);
-                push(a, b + 1);
+                for &t in tris {
+                    visit(i, t as usize);
+                }
             }
         }
     }
+}
+
+/// Call `push` with each node pair the traversal descends to from the pair `(a, b)` (a node
+/// against itself: its children against themselves and each other; two nodes: the larger
+/// one's children against the other), in the order it takes them last first; false for a pair
+/// of leaves, which it does not split.
+fn descend(tree: &SurfaceTree, (a, b): (usize, usize), mut push: impl FnMut(usize, usize)) -> bool {
+    let (na, nb) = (tree.nodes[a], tree.nodes[b]);
+    if a == b && !na.is_leaf() {
+        let (l, r) = (a + 1, na.right as usize);
+        push(r, l);
+        push(l, r);
+        push(r, r);
+        push(l, l);
+    } else if na.is_leaf() && nb.is_leaf() {
+        return false;
+    } else if !na.is_leaf() && (nb.is_leaf() || na.size() >= nb.size()) {
+        push(na.right as usize, b);
+        push(a + 1, b);
+    } else {
+        push(a, nb.right as usize);
+        push(a, b + 1);
+    }
+    true
 }
 
 #[cfg(test)]
@@ -464,7 +519,8 @@ pub(crate) mod tests {
         (triangle, vertex.collect())
     }
 
-    /// Every pair the exact test could keep is visited, exactly once: a vertex facing a
+    /// Every pair the exact test could keep is visited, exactly once, from the root as from
+    /// seeds for several traversals: a vertex facing a
     /// triangle (normals more than 90° apart, or more than 90° less the cones' widening) that
     /// is not one of its corners, the box of its two positions meeting the triangle's box at
     /// both grown by the reach. On a sphere pressed flat between two planes until its caps
@@ -498,10 +554,21 @@ pub(crate) mod tests {
                 skin,
                 (turn.cos(), turn.sin()),
             );
-            let mut visits = vec![0u8; rest.len() * boundary.len()];
-            fit.for_each_candidate(&tree, &vertex_normal, |i, t| {
-                visits[i * boundary.len() + t] += 1;
-            });
+            // From the root, and from seeds split for 16 traversals: the same pairs.
+            let visits_from = |want: usize| {
+                let mut visits = vec![0u8; rest.len() * boundary.len()];
+                let (seeds, count) = fit.seeds(&tree, want);
+                for &seed in &seeds[..count] {
+                    fit.for_each_candidate(&tree, seed, &vertex_normal, |i, t| {
+                        visits[i * boundary.len() + t] += 1;
+                    });
+                }
+                (visits, count)
+            };
+            let (visits, one) = visits_from(1);
+            let (split, count) = visits_from(16);
+            assert!(one == 1 && count >= 16, "{one} and {count} seeds");
+            assert!(visits == split, "the seeds' traversals visit other pairs");
             assert!(visits.iter().all(|&v| v <= 1), "a pair visited twice");
             let mut needed = 0;
             for (t, corners) in boundary.iter().enumerate() {
