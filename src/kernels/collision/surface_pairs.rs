@@ -119,9 +119,9 @@ impl SurfacePairs {
         }
     }
 
-    /// Drop the built pairs: the boundary's triangles changed, to `triangles` triangles over
-    /// `vertices` of `particles` particles. When the pairs were in use, make room for those
-    /// (so that the next pass allocates nothing).
+    /// Drop the built pairs: the boundary's triangles changed, to the `sizes` of
+    /// [`SurfacePairs::reserve`]. When the pairs were in use, make room for those (so that the
+    /// next pass allocates nothing).
     pub(crate) fn forget(&mut self, sizes: (usize, usize, usize)) {
         self.valid = false;
         if !self.anchor_x.is_empty() {
