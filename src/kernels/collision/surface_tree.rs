@@ -28,8 +28,10 @@ use crate::kernels::collision::aabb::{grow, inflated, merge, motion, overlap, Aa
 use crate::kernels::math::{Real, Vec3};
 
 /// Most triangles in a leaf (dimensionless). Smaller leaves hold tighter cones (fewer pairs
-/// tested exactly) but make more nodes to refit and visit.
-pub(crate) const LEAF_TRIANGLES: usize = 4;
+/// tested exactly) but make more nodes to refit and visit: on the haptic liver_4k, leaves of
+/// 8 make the self-contact pass 7–10% cheaper than leaves of 4 (16: the same as 8), with the
+/// same pairs (docs/PERFORMANCE.md, "Surface self-contact").
+pub(crate) const LEAF_TRIANGLES: usize = 8;
 
 /// Most node pairs [`TreeFit::seeds`] returns (dimensionless).
 pub(crate) const MAX_SEEDS: usize = 64;
