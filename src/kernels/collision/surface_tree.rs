@@ -171,15 +171,13 @@ impl Cone {
         if self.is_empty() || other.is_empty() {
             return true;
         }
-        // cos and sin of γ = the angle between the axes, then of γ + θ₁, then of γ + θ₁ + θ₂,
-        // each kept under 90°.
-        let c = self.axis.dot(&other.axis).clamp(-1.0, 1.0);
-        let s = (1.0 - c * c).max(0.0).sqrt();
-        if c <= 0.0 || self.cos <= 0.0 || other.cos <= 0.0 {
-            return false;
-        }
-        let (c1, s1) = (c * self.cos - s * self.sin, s * self.cos + c * self.sin);
-        c1 > 0.0 && c1 * other.cos - s1 * other.sin > FACING_MARGIN
+        // γ (the angle between the axes) + θ₁ + θ₂ under 90°: each half-angle and their sum
+        // under 90°, and cos γ above cos(90° − θ₁ − θ₂) = sin(θ₁ + θ₂).
+        let (c1, s1, c2, s2) = (self.cos, self.sin, other.cos, other.sin);
+        c1 > 0.0
+            && c2 > 0.0
+            && c1 * c2 - s1 * s2 > 0.0
+            && self.axis.dot(&other.axis) > s1 * c2 + c1 * s2 + FACING_MARGIN
     }
 }
 
