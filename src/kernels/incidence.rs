@@ -1,21 +1,24 @@
-//! Which tetrahedra each node belongs to: the incidence the per-particle passes read.
+//! Which elements each node belongs to: the incidence the per-particle passes read.
 
-/// The corners of `tets` around each of `n` nodes: `slots[offsets[i]..offsets[i + 1]]` are
-/// the slots `4 t + c` with corner `c` of tetrahedron `t` equal to `i`, in increasing `t`
-/// (`offsets` has `n + 1` entries).
-pub(crate) fn corners_around(tets: &[[u32; 4]], n: usize) -> (Vec<u32>, Vec<u32>) {
+/// The corners of `elements` (tetrahedra, triangles: `N` corners each) around each of `n`
+/// nodes: `slots[offsets[i]..offsets[i + 1]]` are the slots `N e + c` with corner `c` of element
+/// `e` equal to `i`, in increasing `e` (`offsets` has `n + 1` entries).
+pub(crate) fn corners_around<const N: usize>(
+    elements: &[[u32; N]],
+    n: usize,
+) -> (Vec<u32>, Vec<u32>) {
     let mut offsets = vec![0u32; n + 1];
-    for tet in tets {
-        tet.iter().for_each(|&k| offsets[k as usize + 1] += 1);
+    for element in elements {
+        element.iter().for_each(|&k| offsets[k as usize + 1] += 1);
     }
     for i in 0..n {
         offsets[i + 1] += offsets[i];
     }
     let mut next = offsets.clone();
     let mut slots = vec![0u32; offsets[n] as usize];
-    for (t, tet) in tets.iter().enumerate() {
-        for (c, &k) in tet.iter().enumerate() {
-            slots[next[k as usize] as usize] = (4 * t + c) as u32;
+    for (e, element) in elements.iter().enumerate() {
+        for (c, &k) in element.iter().enumerate() {
+            slots[next[k as usize] as usize] = (N * e + c) as u32;
             next[k as usize] += 1;
         }
     }

@@ -49,16 +49,17 @@
 //! little ([`SurfacePairs`](crate::kernels::collision::surface_pairs::SurfacePairs), one per body
 //! in its step scratch) and filtered every pass by the boxes and normals; the pass then costs the
 //! normals, a scan of the boundary's motion and the exact tests, and a build of the pairs when
-//! the surface moved too far (its traversal split over the pool's threads, the pairs found
-//! sorted). The projections run on the calling thread, the pairs in (vertex, triangle) order:
-//! the same bits for any thread count and whenever the pairs were built.
+//! the surface moved too far. The normals, the scan and a build's refit and traversal run on
+//! the pool's threads (the pairs found sorted); the projections on the calling thread, the
+//! pairs in (vertex, triangle) order: the same bits for any thread count and whenever the pairs
+//! were built.
 
 use crate::interaction::surface_contact::MAX_CORNER_SHARE;
 use crate::kernels::collision::surface_pairs::SurfaceMotion;
 use crate::kernels::collision::surface_tree::TreeFit;
 use crate::kernels::constraints::friction::friction_correction;
 use crate::kernels::math::{Real, Vec3};
-use crate::kernels::parallel::Pool;
+use crate::kernels::parallel::{Pool, SharedSlice};
 use crate::model::body_model::BodyModel;
 use crate::scene::body::Body;
 use crate::solver::StepScratch;
@@ -75,10 +76,12 @@ pub(crate) const SELF_CONTACT_SKIN: Real = 0.5;
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SelfContactScratch {
     fit: TreeFit,
-    /// Per boundary triangle, its unit outward normal at the start of the pass.
+    /// Per boundary triangle, the cross product of two of its edges at the start of the pass
+    /// (m²: its outward normal times twice its area), and that normal's unit vector.
+    area_normal: Vec<Vec3>,
     normal: Vec<Vec3>,
-    /// Per particle, the unit normal of the boundary around it: the sum of the cross products
-    /// of the boundary triangles around it, normalised (zero where that sum is; written for
+    /// Per particle, the unit normal of the boundary around it: the sum of the area normals of
+    /// the boundary triangles around it, normalised (zero where that sum is; written for
     /// boundary vertices only).
     vertex_normal: Vec<Vec3>,
 }
@@ -88,13 +91,71 @@ impl SelfContactScratch {
     pub(crate) fn reserve(&mut self, model: &BodyModel) {
         let (triangles, particles) = (model.boundary.len(), model.particle_count());
         self.fit.reserve(&model.boundary_tree, particles);
-        if self.normal.len() < triangles {
-            self.normal.resize(triangles, Vec3::zeros());
+        for per_triangle in [&mut self.area_normal, &mut self.normal] {
+            if per_triangle.len() < triangles {
+                per_triangle.resize(triangles, Vec3::zeros());
+            }
         }
         if self.vertex_normal.len() < particles {
             self.vertex_normal.resize(particles, Vec3::zeros());
         }
     }
+}
+
+/// The boundary's normals at the positions `p` (m) into `scratch` (see
+/// [`SelfContactScratch`]), on the threads of `pool`: the triangles' in ranges, then each
+/// vertex's sum of its triangles' area normals in the order of the triangles (on one thread,
+/// each triangle's added to its corners' sums in that order: the same bits, and cheaper
+/// there).
+fn boundary_normals(scratch: &mut SelfContactScratch, model: &BodyModel, p: &[Vec3], pool: &Pool) {
+    let (boundary, tree) = (&model.boundary, &model.boundary_tree);
+    let triangles = boundary.len();
+    if pool.threads() == 1 {
+        let SelfContactScratch {
+            normal,
+            vertex_normal,
+            ..
+        } = scratch;
+        for &i in tree.vertices() {
+            vertex_normal[i as usize] = Vec3::zeros();
+        }
+        for (t, corners) in boundary.iter().enumerate() {
+            let [a, b, c] = corners.map(|k| p[k as usize]);
+            let area_normal = (b - a).cross(&(c - a));
+            for &k in corners {
+                vertex_normal[k as usize] += area_normal;
+            }
+            normal[t] = area_normal.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        }
+        for &i in tree.vertices() {
+            let n = &mut vertex_normal[i as usize];
+            *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        }
+        return;
+    }
+    let area = SharedSlice::new(&mut scratch.area_normal[..triangles]);
+    let unit = SharedSlice::new(&mut scratch.normal[..triangles]);
+    pool.for_each_range(triangles, &|range| {
+        // SAFETY: the shares' ranges are disjoint.
+        let (area, unit) = unsafe { (area.range(range.clone()), unit.range(range.clone())) };
+        for ((t, area), unit) in range.zip(area).zip(unit) {
+            let [a, b, c] = boundary[t].map(|k| p[k as usize]);
+            *area = (b - a).cross(&(c - a));
+            *unit = area.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        }
+    });
+    let area = &scratch.area_normal;
+    let vertex_normal = SharedSlice::new(&mut scratch.vertex_normal);
+    pool.for_each_range(tree.vertices().len(), &|range| {
+        for j in range {
+            let sum = (tree.triangles_around(j).iter())
+                .fold(Vec3::zeros(), |sum, &t| sum + area[t as usize]);
+            // SAFETY: every boundary vertex is once in the tree's vertices. A zero normal
+            // faces no triangle (condition 2).
+            *unsafe { vertex_normal.element(tree.vertices()[j] as usize) } =
+                sum.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        }
+    });
 }
 
 /// The sizes the self-contact's pairs are made for on `model` (`SurfacePairs::reserve`): its
@@ -126,27 +187,13 @@ pub(crate) fn project_self_contacts(
     let skin = SELF_CONTACT_SKIN * model.particle_radius;
     let (x, w, rest) = (&body.state.x, &body.inv_mass, &model.rest);
     let p = &step.p;
+    boundary_normals(scratch, model, p, pool);
     let SelfContactScratch {
         fit,
         normal,
         vertex_normal,
+        ..
     } = scratch;
-    for &i in &model.boundary_vertices {
-        vertex_normal[i as usize] = Vec3::zeros();
-    }
-    for (t, corners) in boundary.iter().enumerate() {
-        let [a, b, c] = corners.map(|k| p[k as usize]);
-        let area_normal = (b - a).cross(&(c - a));
-        for &k in corners {
-            vertex_normal[k as usize] += area_normal;
-        }
-        normal[t] = area_normal.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
-    }
-    for &i in &model.boundary_vertices {
-        let n = &mut vertex_normal[i as usize];
-        // A zero normal faces no triangle (condition 2).
-        *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
-    }
     let motion = SurfaceMotion {
         x,
         p,

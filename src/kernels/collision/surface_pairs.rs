@@ -57,6 +57,9 @@ pub(crate) struct SurfacePairs {
     live: Vec<(u32, u32)>,
     /// Per thread of a build on several, the pairs its share of the traversal found.
     shares: Vec<Vec<(u32, u32)>>,
+    /// Per thread, what its share of a pass's scan found: the box of the displacements since
+    /// the build (m), and whether a normal turned too far.
+    scans: Vec<(Aabb, bool)>,
     /// Per particle, its positions at the substep's start and predicted at the build (m), and
     /// its unit normal then (written for boundary vertices only).
     anchor_x: Vec<Vec3>,
@@ -105,6 +108,9 @@ impl SurfacePairs {
         if threads > 1 && self.shares.len() < threads {
             self.shares.resize(threads, Vec::new());
         }
+        if self.scans.len() < threads {
+            self.scans.resize(threads, (EMPTY_BOX, false));
+        }
         // A share's list: twice an even share of the pairs.
         let share = match threads {
             1 => 0,
@@ -148,7 +154,7 @@ impl SurfacePairs {
         skin: Real,
     ) -> &[(u32, u32)] {
         let margin = REUSE_MARGIN * skin;
-        if !self.valid || self.moved((boundary, vertices), motion, margin) {
+        if !self.valid || self.moved((boundary, vertices), motion, margin, pool) {
             let reach = skin + margin;
             self.build((tree, fit, pool), (boundary, vertices), motion, reach);
         }
@@ -171,32 +177,47 @@ impl SurfacePairs {
     /// coordinate since the build (the spread of the displacements of every boundary vertex's
     /// `x` and `p`: a common translation moves no box against another), or a unit normal
     /// turned by more than [`REUSE_TURN`]: a normal that was zero and is not counts as turned,
-    /// one that is zero now faces nothing.
+    /// one that is zero now faces nothing. Scanned in ranges on the threads of `pool`.
     fn moved(
-        &self,
+        &mut self,
         (boundary, vertices): (&[[u32; 3]], &[u32]),
         motion: &SurfaceMotion,
         margin: Real,
+        pool: &Pool,
     ) -> bool {
         let least_cos = REUSE_TURN.cos();
         let turned = |now: &Vec3, then: &Vec3| *now != Vec3::zeros() && now.dot(then) < least_cos;
-        let mut spread = EMPTY_BOX;
-        for &k in vertices {
-            let k = k as usize;
-            grow(&mut spread, &(motion.x[k] - self.anchor_x[k]));
-            grow(&mut spread, &(motion.p[k] - self.anchor_p[k]));
-            if turned(&motion.vertex_normal[k], &self.anchor_vertex_normal[k]) {
-                return true;
+        let threads = pool.threads();
+        let scans = SharedSlice::new(&mut self.scans[..threads]);
+        let this = &*self;
+        pool.run(&|share| {
+            // SAFETY: each share writes its own entry.
+            let scan = unsafe { scans.element(share) };
+            *scan = (EMPTY_BOX, true);
+            let mut spread = EMPTY_BOX;
+            for &k in &vertices[pool.share(share, vertices.len())] {
+                let k = k as usize;
+                grow(&mut spread, &(motion.x[k] - this.anchor_x[k]));
+                grow(&mut spread, &(motion.p[k] - this.anchor_p[k]));
+                if turned(&motion.vertex_normal[k], &this.anchor_vertex_normal[k]) {
+                    return;
+                }
             }
-        }
+            let triangles = pool.share(share, boundary.len());
+            let normals = motion.normal[triangles.clone()].iter();
+            if !normals
+                .zip(&this.anchor_normal[triangles])
+                .any(|(now, then)| turned(now, then))
+            {
+                *scan = (spread, false);
+            }
+        });
+        let (spread, any_turned) = (self.scans[..threads].iter())
+            .fold((EMPTY_BOX, false), |(b, t), (share, turned)| {
+                (merge(&b, share), t || *turned)
+            });
         // Under the margin by far more than rounding.
-        if (spread.1 - spread.0).amax() > 0.998 * margin {
-            return true;
-        }
-        let triangles = boundary.len();
-        (motion.normal[..triangles].iter())
-            .zip(&self.anchor_normal)
-            .any(|(now, then)| turned(now, then))
+        any_turned || (spread.1 - spread.0).amax() > 0.998 * margin
     }
 
     /// Build the pairs within `reach` (m: the skin and the margin) whose normals are more than
@@ -218,6 +239,7 @@ impl SurfacePairs {
             normals,
             reach,
             (turn.cos(), turn.sin()),
+            pool,
         );
         // Above sin 2θ by far more than rounding.
         let facing = turn.sin() + 1.0e-9;

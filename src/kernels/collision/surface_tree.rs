@@ -5,10 +5,13 @@
 //! split at the median of their rest centroids along the longest side of their box, down to
 //! leaves of at most [`LEAF_TRIANGLES`]) and kept until the boundary changes (a cut). Every
 //! boundary vertex belongs to one leaf, the first (in the tree's order) with a triangle at it,
-//! so that a subtree holds a run of the triangles and a run of the vertices.
+//! so that a subtree holds a run of the triangles and a run of the vertices. The tree also
+//! lists the triangles around each vertex, so that a vertex's normal can be gathered on any
+//! thread.
 //!
-//! Every pass refits it ([`TreeFit::refit`]): per node the box of its triangles' corners at
-//! the start of the substep and at the predicted positions, grown by the contact skin, the box
+//! A build of the pairs refits it ([`TreeFit::refit`], subtrees on several threads): per node
+//! the box of its triangles' corners at the start of the substep and at the predicted positions,
+//! grown by the reach (the contact skin and a margin), the box
 //! of its vertices at both, and the cones of its triangles' unit normals and of its vertices'
 //! unit normals (an axis and a half-angle). A vertex and a triangle can only be in contact when
 //! the vertex's box meets the triangle's grown box (it is within the skin of the triangle, or
@@ -25,7 +28,9 @@
 //! threads.
 
 use crate::kernels::collision::aabb::{grow, inflated, merge, motion, overlap, Aabb, EMPTY_BOX};
+use crate::kernels::incidence::corners_around;
 use crate::kernels::math::{Real, Vec3};
+use crate::kernels::parallel::{Pool, SharedSlice};
 
 /// Most triangles in a leaf (dimensionless). Smaller leaves hold tighter cones (fewer pairs
 /// tested exactly) but make more nodes to refit and visit: on the haptic liver_4k, leaves of
@@ -65,7 +70,7 @@ impl Node {
 
 /// A cone of unit vectors: those within the half-angle `θ` (`cos θ`, `sin θ`) of `axis`.
 /// [`Cone::EMPTY`] holds none, a cosine of −1 all.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Cone {
     axis: Vec3,
     cos: Real,
@@ -190,23 +195,50 @@ pub(crate) struct SurfaceTree {
     triangles: Vec<u32>,
     /// Boundary vertices (particle indices) in the tree's order.
     vertices: Vec<u32>,
+    /// The triangles around each of `vertices` (indices into the boundary, increasing):
+    /// `around[around_offsets[j]..around_offsets[j + 1]]` for the `j`-th.
+    around_offsets: Vec<u32>,
+    around: Vec<u32>,
 }
 
 /// The boxes and cones of a [`SurfaceTree`]'s nodes at the last refit, one entry per node.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct TreeFit {
-    /// Its triangles' corners' box grown by the skin, and its vertices' box (m).
-    triangle_box: Vec<Aabb>,
-    vertex_box: Vec<Aabb>,
-    /// The cones of its triangles' and of its vertices' unit normals.
-    triangle_cone: Vec<Cone>,
-    vertex_cone: Vec<Cone>,
+    nodes: Vec<NodeFit>,
     /// Per particle, the box of its position at the substep's start and its predicted one (m;
     /// written for boundary vertices only).
     hull: Vec<Aabb>,
     /// The cosine and sine of the angle the vertices' cones are widened by at the last refit.
     turn: (Real, Real),
 }
+
+/// A node's boxes and cones at the last refit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NodeFit {
+    /// Its triangles' corners' box grown by the reach, and its vertices' box (m).
+    triangle_box: Aabb,
+    vertex_box: Aabb,
+    /// The cones of its triangles' and of its vertices' unit normals.
+    triangle_cone: Cone,
+    vertex_cone: Cone,
+}
+
+impl NodeFit {
+    const EMPTY: NodeFit = NodeFit {
+        triangle_box: EMPTY_BOX,
+        vertex_box: EMPTY_BOX,
+        triangle_cone: Cone::EMPTY,
+        vertex_cone: Cone::EMPTY,
+    };
+}
+
+/// Subtrees per thread a refit on several threads deals round them (dimensionless): enough to
+/// even out the shares' work.
+const SUBTREES_PER_THREAD: usize = 4;
+
+/// Most subtrees a refit splits the tree into, and most nodes above them (dimensionless):
+/// [`SurfaceTree::subtrees`] keeps their count under twice what it is asked for, plus one.
+const MAX_SUBTREES: usize = 2 * MAX_SEEDS;
 
 impl SurfaceTree {
     /// The tree over `boundary` (corner particle indices) at the rest positions `rest` (m).
@@ -247,7 +279,25 @@ impl SurfaceTree {
                 tree.nodes[n].verts = (left.verts.0, right.verts.1);
             }
         }
+        let (offsets, slots) = corners_around(boundary, rest.len());
+        tree.around_offsets.push(0);
+        for &k in &tree.vertices {
+            let mine = &slots[offsets[k as usize] as usize..offsets[k as usize + 1] as usize];
+            tree.around.extend(mine.iter().map(|slot| slot / 3));
+            tree.around_offsets.push(tree.around.len() as u32);
+        }
         tree
+    }
+
+    /// The boundary vertices (particle indices) in the tree's order.
+    pub(crate) fn vertices(&self) -> &[u32] {
+        &self.vertices
+    }
+
+    /// The triangles (indices into the boundary) around the `j`-th of
+    /// [`SurfaceTree::vertices`], in increasing order.
+    pub(crate) fn triangles_around(&self, j: usize) -> &[u32] {
+        &self.around[self.around_offsets[j] as usize..self.around_offsets[j + 1] as usize]
     }
 
     /// Make the subtree of the triangles `start..end` of the tree's order; returns its node.
@@ -283,6 +333,48 @@ impl SurfaceTree {
         use std::mem::size_of;
         self.nodes.capacity() * size_of::<Node>()
             + 4 * (self.triangles.capacity() + self.vertices.capacity())
+            + 4 * (self.around_offsets.capacity() + self.around.capacity())
+    }
+
+    /// The node after the last of the subtree at `node` (depth-first order keeps a subtree's
+    /// nodes together): past its rightmost leaf.
+    fn subtree_end(&self, mut node: usize) -> usize {
+        while !self.nodes[node].is_leaf() {
+            node = self.nodes[node].right as usize;
+        }
+        node + 1
+    }
+
+    /// The tree cut for a refit on several threads: the largest subtrees that hold at most a
+    /// `want`-th of the triangles (leaves where those are larger), at most [`MAX_SUBTREES`] for
+    /// `want` up to half that, and the nodes above them, each list in the tree's order.
+    fn subtrees(&self, want: usize) -> [([u32; MAX_SUBTREES], usize); 2] {
+        let target = self
+            .triangles
+            .len()
+            .div_ceil(want.clamp(1, MAX_SUBTREES / 2));
+        let (mut roots, mut above) = (([0; MAX_SUBTREES], 0), ([0; MAX_SUBTREES], 0));
+        // A subtree is split only when it holds more than `target`, into halves (median
+        // splits) of more than half of it: so under `2 want` subtrees and fewer nodes above.
+        // Pending nodes: one per level and the last split's two, under 32 + 2.
+        let mut pending = [0u32; 34];
+        let mut top = usize::from(!self.nodes.is_empty());
+        while top > 0 {
+            top -= 1;
+            let n = pending[top];
+            let node = self.nodes[n as usize];
+            let list = if node.is_leaf() || node.size() as usize <= target {
+                &mut roots
+            } else {
+                pending[top] = node.right;
+                pending[top + 1] = n + 1;
+                top += 2;
+                &mut above
+            };
+            list.0[list.1] = n;
+            list.1 += 1;
+        }
+        [roots, above]
     }
 }
 
@@ -293,12 +385,8 @@ impl TreeFit {
         if self.hull.len() < particles {
             self.hull.resize(particles, EMPTY_BOX);
         }
-        let count = tree.nodes.len();
-        if self.triangle_box.len() < count {
-            self.triangle_box.resize(count, EMPTY_BOX);
-            self.vertex_box.resize(count, EMPTY_BOX);
-            self.triangle_cone.resize(count, Cone::EMPTY);
-            self.vertex_cone.resize(count, Cone::EMPTY);
+        if self.nodes.len() < tree.nodes.len() {
+            self.nodes.resize(tree.nodes.len(), NodeFit::EMPTY);
         }
     }
 
@@ -308,8 +396,11 @@ impl TreeFit {
     /// `vertex_normal` (per particle, zero for a vertex that faces nothing), the triangles'
     /// boxes grown by `reach` (m) and the vertices' cones by the angle whose cosine and sine
     /// are `turn` (at most 90°: the pairs kept then include those whose normals could face
-    /// each other after each normal turned by half of it). Needs [`TreeFit::reserve`] for
-    /// `tree`.
+    /// each other after each normal turned by half of it), on the threads of `pool`: the
+    /// vertices' boxes in ranges, then subtrees dealt round the threads, then the nodes above
+    /// them (each node's fit is the same whichever thread computes it). Needs
+    /// [`TreeFit::reserve`] for `tree`.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn refit(
         &mut self,
         tree: &SurfaceTree,
@@ -318,40 +409,67 @@ impl TreeFit {
         (normal, vertex_normal): (&[Vec3], &[Vec3]),
         reach: Real,
         turn: (Real, Real),
+        pool: &Pool,
     ) {
         self.turn = turn;
-        for &k in &tree.vertices {
-            let k = k as usize;
-            self.hull[k] = motion(&x[k], &p[k]);
-        }
+        let hull = SharedSlice::new(&mut self.hull);
+        pool.for_each_range(tree.vertices.len(), &|range| {
+            for &k in &tree.vertices[range] {
+                let k = k as usize;
+                // SAFETY: every boundary vertex is once in the tree's vertices.
+                *unsafe { hull.element(k) } = motion(&x[k], &p[k]);
+            }
+        });
         let hull = &self.hull;
-        for n in (0..tree.nodes.len()).rev() {
+        // Node `n` from its children (at `n − base` in `fits`) or its leaf's triangles.
+        let fit = |fits: &mut [NodeFit], base: usize, n: usize| {
             let node = tree.nodes[n];
-            if node.is_leaf() {
+            fits[n - base] = if node.is_leaf() {
                 let tris = &tree.triangles[node.tris.0 as usize..node.tris.1 as usize];
                 let verts = &tree.vertices[node.verts.0 as usize..node.verts.1 as usize];
                 let corners = (tris.iter().flat_map(|&t| boundary[t as usize]))
                     .fold(EMPTY_BOX, |b, k| merge(&b, &hull[k as usize]));
-                self.triangle_box[n] = inflated(&corners, reach);
-                self.vertex_box[n] =
-                    (verts.iter()).fold(EMPTY_BOX, |b, &k| merge(&b, &hull[k as usize]));
-                self.triangle_cone[n] = Cone::of(tris.iter().map(|&t| normal[t as usize]));
-                self.vertex_cone[n] =
-                    Cone::of(verts.iter().map(|&k| vertex_normal[k as usize])).widened(turn);
+                NodeFit {
+                    triangle_box: inflated(&corners, reach),
+                    vertex_box: (verts.iter())
+                        .fold(EMPTY_BOX, |b, &k| merge(&b, &hull[k as usize])),
+                    triangle_cone: Cone::of(tris.iter().map(|&t| normal[t as usize])),
+                    vertex_cone: Cone::of(verts.iter().map(|&k| vertex_normal[k as usize]))
+                        .widened(turn),
+                }
             } else {
-                let (l, r) = (n + 1, node.right as usize);
-                self.triangle_box[n] = merge(&self.triangle_box[l], &self.triangle_box[r]);
-                self.vertex_box[n] = merge(&self.vertex_box[l], &self.vertex_box[r]);
-                self.triangle_cone[n] = self.triangle_cone[l].union(&self.triangle_cone[r]);
-                self.vertex_cone[n] = self.vertex_cone[l].union(&self.vertex_cone[r]);
-            }
+                let (l, r) = (&fits[n + 1 - base], &fits[node.right as usize - base]);
+                NodeFit {
+                    triangle_box: merge(&l.triangle_box, &r.triangle_box),
+                    vertex_box: merge(&l.vertex_box, &r.vertex_box),
+                    triangle_cone: l.triangle_cone.union(&r.triangle_cone),
+                    vertex_cone: l.vertex_cone.union(&r.vertex_cone),
+                }
+            };
+        };
+        let fits = &mut self.nodes[..tree.nodes.len()];
+        let threads = pool.threads();
+        if threads == 1 {
+            (0..fits.len()).rev().for_each(|n| fit(fits, 0, n));
+            return;
         }
+        let [(roots, count), (above, above_count)] = tree.subtrees(SUBTREES_PER_THREAD * threads);
+        let shared = SharedSlice::new(fits);
+        pool.run(&|share| {
+            for &root in roots[..count].iter().skip(share).step_by(threads) {
+                let nodes = root as usize..tree.subtree_end(root as usize);
+                // SAFETY: the subtrees hold disjoint runs of nodes.
+                let mine = unsafe { shared.range(nodes.clone()) };
+                nodes.clone().rev().for_each(|n| fit(mine, nodes.start, n));
+            }
+        });
+        (above[..above_count].iter().rev()).for_each(|&n| fit(fits, 0, n as usize));
     }
 
     /// Whether the vertices of node `a` can touch the triangles of node `b` (last refit).
     fn may_touch(&self, a: usize, b: usize) -> bool {
-        overlap(&self.vertex_box[a], &self.triangle_box[b])
-            && !self.vertex_cone[a].never_faces(&self.triangle_cone[b])
+        let (a, b) = (&self.nodes[a], &self.nodes[b]);
+        overlap(&a.vertex_box, &b.triangle_box) && !a.vertex_cone.never_faces(&b.triangle_cone)
     }
 
     /// Node pairs to start traversals from ([`TreeFit::for_each_candidate`]) that together
@@ -428,7 +546,7 @@ impl TreeFit {
             let (na, nb) = (tree.nodes[a], tree.nodes[b]);
             let verts = &tree.vertices[na.verts.0 as usize..na.verts.1 as usize];
             let tris = &tree.triangles[nb.tris.0 as usize..nb.tris.1 as usize];
-            let (reach, cone) = (&self.triangle_box[b], &self.triangle_cone[b]);
+            let (reach, cone) = (&self.nodes[b].triangle_box, &self.nodes[b].triangle_cone);
             for &i in verts {
                 let i = i as usize;
                 if !overlap(&self.hull[i], reach)
@@ -543,16 +661,18 @@ pub(crate) mod tests {
             let p: Vec<Vec3> = x.iter().map(|x| x + jitter()).collect();
             let (normal, vertex_normal) = unit_normals(&p, &boundary);
             let skin = 0.02;
-            let mut fit = TreeFit::default();
-            fit.reserve(&tree, rest.len());
+            // Refitted on one thread and on three: the same boxes and cones.
+            let [mut fit, mut on_three] = [TreeFit::default(), TreeFit::default()];
             let normals = (normal.as_slice(), vertex_normal.as_slice());
-            fit.refit(
-                &tree,
-                &boundary,
-                (&x, &p),
-                normals,
-                skin,
-                (turn.cos(), turn.sin()),
+            for (f, threads) in [(&mut fit, 1), (&mut on_three, 3)] {
+                f.reserve(&tree, rest.len());
+                let pool = Pool::new(threads);
+                let turn = (turn.cos(), turn.sin());
+                f.refit(&tree, &boundary, (&x, &p), normals, skin, turn, &pool);
+            }
+            assert!(
+                fit.nodes == on_three.nodes,
+                "the refit on three threads differs"
             );
             // From the root, and from seeds split for 16 traversals: the same pairs.
             let visits_from = |want: usize| {
